@@ -1,0 +1,1 @@
+//! optics (in progress)

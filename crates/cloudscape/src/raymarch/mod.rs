@@ -1,0 +1,1 @@
+//! raymarch (in progress)

@@ -1,0 +1,509 @@
+//! The scene data model: everything a render needs, in physical units.
+//!
+//! Coordinates: right-handed, metres, `y` up, `x` east, `z` south (so north is `-z`). Azimuths are
+//! measured in degrees clockwise from north (90 = east). With a spherical planet the ground point
+//! under the origin is `(0, 0, 0)` and the planet centre is `(0, -radius_m, 0)`.
+//!
+//! Radiometry: radiance and irradiance share one relative radiometric unit (think W m^-2 sr^-1 and
+//! W m^-2, scaled); only ratios matter, and exposure maps them to the display.
+
+use serde::{Deserialize, Serialize};
+
+/// A whole scene: camera, light, sky, ground, planet, clouds and render settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Scene {
+    /// Where the eye is and where it looks.
+    pub camera: Camera,
+    /// The sun: direction, irradiance and colour.
+    pub sun: Sun,
+    /// Sky light falling on the clouds and seen behind them.
+    pub sky: Sky,
+    /// The ground below the clouds (the planet surface, or a flat plane).
+    pub ground: Ground,
+    /// The planet's shape.
+    pub planet: Planet,
+    /// Cloud layers; an empty list gives a clear sky.
+    pub layers: Vec<CloudLayer>,
+    /// The 2D weather map that places clouds within every layer.
+    pub weather: WeatherMap,
+    /// Shape of the procedural 3D noise that builds each cloud.
+    pub noise: NoiseSettings,
+    /// Density grids loaded from files and placed in the world.
+    pub volumes: Vec<VolumeGrid>,
+    /// The single-scattering phase function of cloud droplets.
+    pub phase: PhaseFunction,
+    /// Lighting approximations used by the real-time techniques.
+    pub lighting: Lighting,
+    /// Image size, technique, quality, exposure and output.
+    pub render: RenderSettings,
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Scene {
+            camera: Camera::default(),
+            sun: Sun::default(),
+            sky: Sky::default(),
+            ground: Ground::default(),
+            planet: Planet::default(),
+            layers: vec![CloudLayer::default()],
+            weather: WeatherMap::default(),
+            noise: NoiseSettings::default(),
+            volumes: Vec::new(),
+            phase: PhaseFunction::default(),
+            lighting: Lighting::default(),
+            render: RenderSettings::default(),
+        }
+    }
+}
+
+/// A pinhole camera.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Camera {
+    /// Eye position in metres (`y` is altitude above the ground under the origin).
+    pub position_m: [f32; 3],
+    /// Point looked at, in metres; when absent, `yaw_deg` and `pitch_deg` give the view direction.
+    pub look_at_m: Option<[f32; 3]>,
+    /// View azimuth in degrees clockwise from north (used without `look_at_m`).
+    pub yaw_deg: f32,
+    /// View elevation in degrees above the horizon, -90..90 (used without `look_at_m`).
+    pub pitch_deg: f32,
+    /// Vertical field of view in degrees, 1..179.
+    pub fov_y_deg: f32,
+    /// Near clip distance in metres (> 0).
+    pub near_m: f32,
+    /// Far distance in metres: nothing beyond it is marched (> near).
+    pub far_m: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera {
+            position_m: [0.0, 30.0, 0.0],
+            look_at_m: None,
+            yaw_deg: 200.0,
+            pitch_deg: 14.0,
+            fov_y_deg: 65.0,
+            near_m: 0.1,
+            far_m: 120_000.0,
+        }
+    }
+}
+
+/// The sun, a distant disc light.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Sun {
+    /// Elevation above the horizon in degrees, -90..90.
+    pub elevation_deg: f32,
+    /// Azimuth in degrees clockwise from north.
+    pub azimuth_deg: f32,
+    /// Irradiance on a surface facing the sun, in scene radiometric units (> 0 or 0 for no sun).
+    pub irradiance: f32,
+    /// Linear RGB colour multiplying the irradiance, each 0..1.
+    pub color: [f32; 3],
+    /// Angular radius of the disc in degrees, 0..5; 0.2679 deg is the real sun (Bruneton 2017).
+    pub angular_radius_deg: f32,
+}
+
+impl Default for Sun {
+    fn default() -> Self {
+        Sun {
+            elevation_deg: 30.0,
+            azimuth_deg: 215.0,
+            irradiance: 8.0,
+            color: [1.0, 0.96, 0.90],
+            angular_radius_deg: 0.2679,
+        }
+    }
+}
+
+/// How sky radiance varies with direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SkyModel {
+    /// The same radiance (`sky.radiance`) in every direction.
+    Constant,
+    /// Horizon radiance blending to zenith radiance with elevation.
+    Gradient,
+}
+
+/// Sky light. The physically based atmosphere comes later; these are its simple stand-ins.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Sky {
+    /// Which sky model to use.
+    pub model: SkyModel,
+    /// Radiance of the constant sky, linear RGB, each >= 0.
+    pub radiance: [f32; 3],
+    /// Gradient sky: radiance straight up, linear RGB, each >= 0.
+    pub zenith_radiance: [f32; 3],
+    /// Gradient sky: radiance at the horizon, linear RGB, each >= 0.
+    pub horizon_radiance: [f32; 3],
+    /// Gradient sky: how fast the horizon colour gives way to the zenith colour, 0.05..10.
+    pub gradient_exponent: f32,
+}
+
+impl Default for Sky {
+    fn default() -> Self {
+        Sky {
+            model: SkyModel::Gradient,
+            radiance: [0.3, 0.3, 0.3],
+            zenith_radiance: [0.10, 0.22, 0.52],
+            horizon_radiance: [0.42, 0.50, 0.62],
+            gradient_exponent: 0.45,
+        }
+    }
+}
+
+/// The ground: a Lambertian surface lit by the sun and the sky.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Ground {
+    /// Whether there is a ground at all; without one, rays below the horizon see the sky.
+    pub enabled: bool,
+    /// Lambertian albedo, linear RGB, each 0..1.
+    pub albedo: [f32; 3],
+}
+
+impl Default for Ground {
+    fn default() -> Self {
+        Ground { enabled: true, albedo: [0.12, 0.13, 0.10] }
+    }
+}
+
+/// The planet's shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanetShape {
+    /// A sphere of `radius_m`: layers follow its curvature and sink below the horizon.
+    Spherical,
+    /// An infinite plane at `y = 0`.
+    Flat,
+}
+
+/// The planet under the clouds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Planet {
+    /// Spherical or flat.
+    pub shape: PlanetShape,
+    /// Radius in metres of the spherical planet, 1 km..100 000 km; Earth is 6 360 km (Bruneton 2017).
+    pub radius_m: f32,
+}
+
+impl Default for Planet {
+    fn default() -> Self {
+        Planet { shape: PlanetShape::Spherical, radius_m: 6_360_000.0 }
+    }
+}
+
+/// Relative amounts of the four canonical cloud types in a layer; at least one must be positive.
+/// The weather map's type channel picks among them (see [`crate::field`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CloudTypeMix {
+    /// Weight of stratus: a thin flat sheet near the layer bottom, >= 0.
+    pub stratus: f32,
+    /// Weight of stratocumulus: lumpy, filling the lower half of the layer, >= 0.
+    pub stratocumulus: f32,
+    /// Weight of cumulus: rounded towers filling most of the layer, >= 0.
+    pub cumulus: f32,
+    /// Weight of cumulonimbus: the full layer with an anvil at the top, >= 0.
+    pub cumulonimbus: f32,
+}
+
+impl Default for CloudTypeMix {
+    /// All zero: a table that names some types leaves the others out.
+    fn default() -> Self {
+        CloudTypeMix { stratus: 0.0, stratocumulus: 0.0, cumulus: 0.0, cumulonimbus: 0.0 }
+    }
+}
+
+fn cumulus_only() -> CloudTypeMix {
+    CloudTypeMix { cumulus: 1.0, ..CloudTypeMix::default() }
+}
+
+/// One layer of clouds between two altitudes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CloudLayer {
+    /// Altitude of the layer bottom above the ground, metres, >= 0.
+    pub bottom_m: f32,
+    /// Thickness of the layer, metres, 10..20 000.
+    pub thickness_m: f32,
+    /// Cloud cover, 0..1: 0 clears the layer, 0.5 keeps the weather map as painted, 1 fills it.
+    pub coverage: f32,
+    /// Extinction coefficient of the densest cloud, m^-1, 0..1 (cumulus 0.04-0.1, physics.md).
+    pub extinction_per_m: f32,
+    /// Mix of cloud types.
+    #[serde(default = "cumulus_only")]
+    pub types: CloudTypeMix,
+    /// Wind velocity in m/s as `[east, south]`: moves the weather map and the noise.
+    pub wind_m_per_s: [f32; 2],
+    /// Seed that shifts this layer's noise and weather so layers do not repeat each other.
+    pub noise_seed: u32,
+}
+
+impl Default for CloudLayer {
+    fn default() -> Self {
+        CloudLayer {
+            bottom_m: 1500.0,
+            thickness_m: 2200.0,
+            coverage: 0.55,
+            extinction_per_m: 0.05,
+            types: cumulus_only(),
+            wind_m_per_s: [8.0, 3.0],
+            noise_seed: 1,
+        }
+    }
+}
+
+/// Where the weather map comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WeatherSource {
+    /// Generated from `seed`.
+    Procedural,
+    /// Read from the PNG at `path`: R coverage, G type (position in the layer's type mix), B density.
+    File,
+}
+
+/// The 2D weather map: per position, cloud coverage, cloud type and density. It repeats every
+/// `extent_km` in both directions.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WeatherMap {
+    /// Procedural or from a file.
+    pub source: WeatherSource,
+    /// Seed of the procedural map.
+    pub seed: u32,
+    /// Side of the square area the map covers before repeating, km, 0.1..10 000.
+    pub extent_km: f32,
+    /// Texels per side of the procedural map, 8..4096.
+    pub resolution: u32,
+    /// Typical size of a cloudy region in the procedural map, km, > 0.
+    pub feature_size_km: f32,
+    /// PNG file for `source = "file"`, relative to the scene file.
+    pub path: Option<String>,
+}
+
+impl Default for WeatherMap {
+    fn default() -> Self {
+        WeatherMap {
+            source: WeatherSource::Procedural,
+            seed: 7,
+            extent_km: 64.0,
+            resolution: 512,
+            feature_size_km: 6.0,
+            path: None,
+        }
+    }
+}
+
+/// The 3D noise that gives clouds their shape (Schneider 2015, Horizon Zero Dawn).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NoiseSettings {
+    /// Seed of the noise textures.
+    pub seed: u32,
+    /// World size of one tile of the 128^3 Perlin-Worley base noise, metres, > 0.
+    pub base_period_m: f32,
+    /// World size of one tile of the 32^3 Worley detail noise, metres, > 0.
+    pub detail_period_m: f32,
+    /// How much the detail noise erodes cloud edges, 0..1.
+    pub detail_erosion: f32,
+    /// How far the curl noise displaces the detail noise, metres, >= 0.
+    pub curl_displacement_m: f32,
+}
+
+impl Default for NoiseSettings {
+    fn default() -> Self {
+        NoiseSettings {
+            seed: 3,
+            base_period_m: 9000.0,
+            detail_period_m: 1200.0,
+            detail_erosion: 0.35,
+            curl_displacement_m: 120.0,
+        }
+    }
+}
+
+/// A density grid from a file, placed in an axis-aligned box in the world.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct VolumeGrid {
+    /// Mitsuba 3 `.vol` file, relative to the scene file.
+    pub path: String,
+    /// Centre of the box, metres.
+    pub center_m: [f32; 3],
+    /// Size of the box along x, y, z, metres, each > 0.
+    pub size_m: [f32; 3],
+    /// Extinction in m^-1 where the grid value is 1, 0..10.
+    pub extinction_per_m: f32,
+}
+
+impl Default for VolumeGrid {
+    fn default() -> Self {
+        VolumeGrid {
+            path: String::new(),
+            center_m: [0.0, 2500.0, -6000.0],
+            size_m: [2000.0, 2000.0, 2000.0],
+            extinction_per_m: 0.05,
+        }
+    }
+}
+
+/// Which phase function scatters light in the cloud.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PhaseModel {
+    /// Approximate Mie for water droplets (Jendersie & d'Eon 2023), from `droplet_diameter_um`.
+    Mie,
+    /// Henyey-Greenstein with asymmetry `g`.
+    Hg,
+    /// `forward_weight * HG(g_forward) + (1 - forward_weight) * HG(g_back)`.
+    DualHg,
+}
+
+/// The phase function and its parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PhaseFunction {
+    /// Which model.
+    pub model: PhaseModel,
+    /// Approximate Mie: effective droplet diameter in micrometres, 5..50.
+    pub droplet_diameter_um: f32,
+    /// Henyey-Greenstein asymmetry, -0.99..0.99.
+    pub g: f32,
+    /// Dual-lobe HG: forward lobe asymmetry, -0.99..0.99.
+    pub g_forward: f32,
+    /// Dual-lobe HG: backward lobe asymmetry, -0.99..0.99.
+    pub g_back: f32,
+    /// Dual-lobe HG: weight of the forward lobe, 0..1.
+    pub forward_weight: f32,
+}
+
+impl Default for PhaseFunction {
+    fn default() -> Self {
+        PhaseFunction {
+            model: PhaseModel::Mie,
+            droplet_diameter_um: 20.0,
+            g: 0.8,
+            g_forward: 0.8,
+            g_back: -0.3,
+            forward_weight: 0.7,
+        }
+    }
+}
+
+/// Lighting approximations of the real-time techniques (the path tracer needs none of them).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Lighting {
+    /// Single-scattering albedo sigma_s / sigma_t, 0..1; cloud droplets are about 1 (physics.md).
+    pub albedo: f32,
+    /// Multiple-scattering octaves (Wrenninge 2013), 1..8; 1 is single scattering only.
+    pub octaves: u32,
+    /// Octave extinction factor `a`, 0..1: each octave sees `a^i` of the optical depth to the sun.
+    pub octave_attenuation: f32,
+    /// Octave scattering factor `b`, 0..1 (keep `b <= a` to conserve energy).
+    pub octave_contribution: f32,
+    /// Octave eccentricity factor `c`, 0..1: each octave's phase anisotropy is scaled by `c^i`.
+    pub octave_eccentricity: f32,
+    /// Scale of the light scattered from the sky and the ground into the cloud, 0..4.
+    pub ambient_scale: f32,
+}
+
+impl Default for Lighting {
+    fn default() -> Self {
+        Lighting {
+            albedo: 1.0,
+            octaves: 3,
+            octave_attenuation: 0.5,
+            octave_contribution: 0.5,
+            octave_eccentricity: 0.5,
+            ambient_scale: 1.0,
+        }
+    }
+}
+
+/// Which renderer draws the clouds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Technique {
+    /// Ray-marched clouds (compute).
+    Raymarch,
+}
+
+/// Named sets of step counts, from fast to converged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Quality {
+    /// Real-time budget on a low-end GPU.
+    Low,
+    /// Real-time budget on a mid-range GPU.
+    Medium,
+    /// Stills: enough steps for no visible banding.
+    High,
+    /// Near-converged: for references and tuning.
+    Ultra,
+}
+
+/// Tone-mapping operator from HDR radiance to display values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Tonemap {
+    /// ACES filmic fit (Hill's RRT+ODT fit).
+    Aces,
+    /// AgX (Sobotka), base look.
+    Agx,
+}
+
+/// Image size, technique, quality and output.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RenderSettings {
+    /// Image width in pixels, 1..the adapter's maximum texture size.
+    pub width: u32,
+    /// Image height in pixels, 1..the adapter's maximum texture size.
+    pub height: u32,
+    /// Which technique renders the clouds.
+    pub technique: Technique,
+    /// Step-count preset.
+    pub quality: Quality,
+    /// Overrides the preset's primary steps per ray, 1..4096.
+    pub primary_steps: Option<u32>,
+    /// Overrides the preset's steps toward the sun per sample, 1..64.
+    pub light_steps: Option<u32>,
+    /// Overrides the preset's jittered passes averaged per pixel, 1..1024.
+    pub samples_per_pixel: Option<u32>,
+    /// Exposure in stops (EV) applied before tone mapping, -20..20.
+    pub exposure_ev: f32,
+    /// Tone-mapping operator for PNG output.
+    pub tonemap: Tonemap,
+    /// Scene time in seconds: wind has moved the clouds by `wind * time_s`.
+    pub time_s: f32,
+    /// Output file: `.png` (tone-mapped sRGB) or `.exr` (linear HDR radiance).
+    pub output: String,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            width: 1280,
+            height: 720,
+            technique: Technique::Raymarch,
+            quality: Quality::High,
+            primary_steps: None,
+            light_steps: None,
+            samples_per_pixel: None,
+            exposure_ev: 0.0,
+            tonemap: Tonemap::Aces,
+            time_s: 0.0,
+            output: "cloudscape.png".to_string(),
+        }
+    }
+}
