@@ -5,6 +5,7 @@
 
 pub mod export;
 pub mod field;
+pub mod frame;
 pub mod gpu;
 pub mod image;
 pub mod optics;

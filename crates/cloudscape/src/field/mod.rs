@@ -1,1 +1,230 @@
-//! field (in progress)
+//! The cloud field: extinction (m^-1) at every point of the world and time, from a [`Scene`].
+//!
+//! This CPU implementation is the specification. `field.wgsl` is its GPU twin, and tests sample both
+//! at the same points. Density follows Schneider 2015 ("The Real-time Volumetric Cloudscapes of
+//! Horizon Zero Dawn", SIGGRAPH Advances): weather coverage, a per-type height gradient, a
+//! Perlin-Worley base shape and Worley detail erosion, with curl noise displacing the detail.
+
+pub mod gpu;
+mod layer;
+pub mod noise;
+pub mod profile;
+pub mod texture;
+pub mod voxel;
+pub mod weather;
+
+pub use layer::LayerField;
+pub use noise::NoiseKind;
+pub use texture::Texture8;
+pub use voxel::VoxelGrid;
+pub use weather::Weather;
+
+use crate::scene::{NoiseSettings, PlanetShape, Scene};
+use glam::{Vec2, Vec3, Vec4};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// Most cloud layers one field holds (the GPU uniform's array size).
+pub const MAX_LAYERS: usize = 4;
+/// Most voxel grids one field holds.
+pub const MAX_VOLUMES: usize = 4;
+
+/// A field that could not be built: which scene key is at fault, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldError {
+    /// Dotted key path in the scene ("weather.path", "volumes.0.path").
+    pub key_path: String,
+    /// What went wrong.
+    pub message: String,
+}
+
+/// A density grid placed in an axis-aligned world box.
+#[derive(Clone, Debug)]
+pub struct PlacedVolume {
+    /// The grid, its values rounded to f16 as the GPU stores them.
+    pub grid: VoxelGrid,
+    /// Minimum corner of the box, metres.
+    pub min_m: Vec3,
+    /// Size of the box, metres.
+    pub size_m: Vec3,
+    /// Extinction where the grid value is 1, m^-1.
+    pub extinction_per_m: f32,
+}
+
+impl PlacedVolume {
+    /// Extinction at `p`, zero outside the box.
+    pub fn extinction_per_m(&self, p: Vec3) -> f32 {
+        let uvw = (p - self.min_m) / self.size_m;
+        if uvw.cmplt(Vec3::ZERO).any() || uvw.cmpgt(Vec3::ONE).any() {
+            return 0.0;
+        }
+        self.grid.sample(uvw) * self.extinction_per_m
+    }
+}
+
+/// Where the planet's ground is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanetGeometry {
+    /// Spherical or flat.
+    pub shape: PlanetShape,
+    /// Radius of the spherical planet, metres.
+    pub radius_m: f32,
+}
+
+impl PlanetGeometry {
+    /// Altitude of `p` above the ground, metres. For the sphere (centre `(0, -R, 0)`) this is
+    /// `(|p|^2 + 2 y R) / (|p - c| + R)`, algebraically `|p - c| - R` but free of the cancellation
+    /// that loses metres in f32 at R = 6360 km.
+    pub fn altitude_m(&self, p: Vec3) -> f32 {
+        match self.shape {
+            PlanetShape::Flat => p.y,
+            PlanetShape::Spherical => {
+                let r = self.radius_m;
+                let to_centre = Vec3::new(p.x, p.y + r, p.z).length();
+                (p.length_squared() + 2.0 * p.y * r) / (to_centre + r)
+            }
+        }
+    }
+}
+
+/// The 3D noise a field samples: computed texel by texel on demand, or baked once for heavy use.
+#[derive(Debug)]
+struct NoiseSource {
+    kind: NoiseKind,
+    seed: u32,
+    baked: OnceLock<Texture8>,
+}
+
+impl NoiseSource {
+    fn new(kind: NoiseKind, seed: u32) -> NoiseSource {
+        NoiseSource { kind, seed, baked: OnceLock::new() }
+    }
+
+    fn sample(&self, uvw: Vec3) -> Vec4 {
+        match self.baked.get() {
+            Some(t) => t.sample(uvw),
+            None => texture::sample_linear(self.kind.dims(), uvw, |t| {
+                texture::unorm8(self.kind.texel(self.seed, t))
+            }),
+        }
+    }
+
+    fn bake(&self) {
+        self.baked.get_or_init(|| self.kind.bake(self.seed));
+    }
+}
+
+/// Every cloud of a scene, as extinction over space and time.
+#[derive(Debug)]
+pub struct CloudField {
+    /// The planet under the layers.
+    pub planet: PlanetGeometry,
+    /// Cloud layers, bottom-up as in the scene.
+    pub layers: Vec<LayerField>,
+    /// The weather map all layers read (each at its own offset).
+    pub weather: Weather,
+    /// Noise periods and erosion.
+    pub noise: NoiseSettings,
+    /// Voxel grids.
+    pub volumes: Vec<PlacedVolume>,
+    base: NoiseSource,
+    detail: NoiseSource,
+    curl: NoiseSource,
+}
+
+impl CloudField {
+    /// Builds the field of `scene`; files (weather PNG, `.vol` grids) resolve against `base_dir`.
+    pub fn new(scene: &Scene, base_dir: &Path) -> Result<CloudField, FieldError> {
+        let err = |key: &str, message: String| FieldError { key_path: key.to_string(), message };
+        if scene.layers.len() > MAX_LAYERS {
+            return Err(err("layers", format!("{} layers given; at most {MAX_LAYERS} are supported", scene.layers.len())));
+        }
+        if scene.volumes.len() > MAX_VOLUMES {
+            return Err(err("volumes", format!("{} volumes given; at most {MAX_VOLUMES} are supported", scene.volumes.len())));
+        }
+        let resolve = |p: &str| -> PathBuf { base_dir.join(p) };
+        let weather_file = scene.weather.path.as_deref().map(resolve);
+        let weather = Weather::from_scene(&scene.weather, weather_file.as_deref()).map_err(|m| err("weather.path", m))?;
+        let volumes = scene
+            .volumes
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let mut grid = VoxelGrid::read_vol(&resolve(&v.path)).map_err(|e| err(&format!("volumes.{i}.path"), e.to_string()))?;
+                grid.values.iter_mut().for_each(|x| *x = half::f16::from_f32(*x).to_f32());
+                let size_m = Vec3::from_array(v.size_m);
+                Ok(PlacedVolume { grid, min_m: Vec3::from_array(v.center_m) - size_m * 0.5, size_m, extinction_per_m: v.extinction_per_m })
+            })
+            .collect::<Result<Vec<_>, FieldError>>()?;
+        let seed = scene.noise.seed;
+        Ok(CloudField {
+            planet: PlanetGeometry { shape: scene.planet.shape, radius_m: scene.planet.radius_m },
+            layers: scene.layers.iter().map(LayerField::new).collect(),
+            weather,
+            noise: scene.noise.clone(),
+            volumes,
+            base: NoiseSource::new(NoiseKind::Base, seed),
+            detail: NoiseSource::new(NoiseKind::Detail, seed),
+            curl: NoiseSource::new(NoiseKind::Curl, seed),
+        })
+    }
+
+    /// Computes all noise texels now (a few seconds on all cores in a release build), making every
+    /// later [`CloudField::extinction_per_m`] call cheap. For CPU renderers; the GPU needs none of it.
+    pub fn bake_noise(&self) {
+        rayon::join(|| self.base.bake(), || rayon::join(|| self.detail.bake(), || self.curl.bake()));
+    }
+
+    /// Seed of the noise textures (the GPU generates them from it).
+    pub fn noise_seed(&self) -> u32 {
+        self.base.seed
+    }
+
+    /// Extinction coefficient sigma_t in m^-1 at world point `p` (metres) at scene time `time_s`:
+    /// the sum over layers and voxel grids.
+    pub fn extinction_per_m(&self, p: Vec3, time_s: f32) -> f32 {
+        let h = self.planet.altitude_m(p);
+        let layers: f32 = self.layers.iter().map(|l| self.layer_extinction(l, p, h, time_s)).sum();
+        layers + self.volumes.iter().map(|v| v.extinction_per_m(p)).sum::<f32>()
+    }
+
+    /// Lowest layer bottom and highest layer top, metres (None without layers).
+    pub fn altitude_range_m(&self) -> Option<(f32, f32)> {
+        let bottom = self.layers.iter().map(|l| l.bottom_m).reduce(f32::min)?;
+        let top = self.layers.iter().map(|l| l.bottom_m + l.thickness_m).reduce(f32::max)?;
+        Some((bottom, top))
+    }
+
+    /// One layer's extinction at `p`, altitude `h`. Each line has a twin in `field.wgsl`.
+    fn layer_extinction(&self, layer: &LayerField, p: Vec3, h: f32, time_s: f32) -> f32 {
+        let f = (h - layer.bottom_m) / layer.thickness_m;
+        if !(0.0..=1.0).contains(&f) {
+            return 0.0;
+        }
+        let wind = layer.wind_m_per_s * time_s;
+        let xz = Vec2::new(p.x, p.z) - wind;
+        let w = self.weather.texture.sample((xz / self.weather.extent_m + layer.weather_offset).extend(0.0));
+        let coverage = layer.local_coverage(w.x);
+        if coverage <= 0.0 {
+            return 0.0;
+        }
+        let type_coord = layer.types.type_coord(w.y);
+        let gradient = profile::height_gradient(type_coord, f);
+        if gradient <= 0.0 {
+            return 0.0;
+        }
+        let q = p - Vec3::new(wind.x, 0.0, wind.y) + layer.noise_offset_m;
+        let base = self.base.sample(q / self.noise.base_period_m);
+        let shaped = layer::base_shape(base) * gradient;
+        let covered = layer::apply_coverage(shaped, coverage, type_coord, f);
+        if covered <= 0.0 {
+            return 0.0;
+        }
+        let curl = self.curl.sample(Vec3::new(q.x, q.z, 0.0) / self.noise.base_period_m);
+        let swirl = (Vec2::new(curl.x, curl.y) * 2.0 - 1.0) * self.noise.curl_displacement_m * (1.0 - f);
+        let detail = self.detail.sample((q + Vec3::new(swirl.x, 0.0, swirl.y)) / self.noise.detail_period_m);
+        let density = layer::erode(covered, detail, f, self.noise.detail_erosion);
+        density * w.z * layer.extinction_per_m
+    }
+}
+

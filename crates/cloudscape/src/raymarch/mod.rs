@@ -1,1 +1,166 @@
-//! raymarch (in progress)
+//! Ray-marched clouds (the volumecloud seed, with Schneider 2015 and Hillaire 2016): a compute pass
+//! that writes, per pixel, the radiance the clouds scatter toward the eye (rgb) and the transmittance
+//! through them (a), stopping at the host's depth buffer. Composite as `scene * a + rgb`.
+
+use crate::field::gpu::{FIELD_WGSL, FieldGpu};
+use crate::gpu::pipeline::{UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d, storage_texture_2d};
+use crate::frame::{FRAME_WGSL, Frame};
+use crate::gpu::GpuContext;
+use crate::optics::{PHASE_WGSL, PhaseLobes};
+use crate::scene::{Quality, Scene};
+use bytemuck::{Pod, Zeroable};
+use glam::{UVec2, UVec4, Vec4};
+
+const RAYMARCH_WGSL: &str = include_str!("raymarch.wgsl");
+
+/// Format of the cloud target: rgb in-scattered radiance, a transmittance.
+pub const CLOUD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// Source of the ray-march program.
+pub fn shader_source() -> String {
+    [FIELD_WGSL, FRAME_WGSL, PHASE_WGSL, RAYMARCH_WGSL].concat()
+}
+
+/// Step counts and lighting of the march.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MarchSettings {
+    /// Samples along each view ray.
+    pub primary_steps: u32,
+    /// Samples toward the sun from each view sample.
+    pub light_steps: u32,
+    /// Jittered marches averaged per pixel.
+    pub samples_per_pixel: u32,
+    /// Multiple-scattering octaves (Wrenninge 2013).
+    pub octaves: u32,
+    /// Octave factors a (extinction), b (scattering), c (eccentricity).
+    pub octave_factors: [f32; 3],
+    /// Single-scattering albedo.
+    pub albedo: f32,
+    /// Scale of sky and ground light.
+    pub ambient_scale: f32,
+    /// Phase function.
+    pub phase: PhaseLobes,
+}
+
+impl MarchSettings {
+    /// Steps of a quality preset: (primary, light, samples per pixel).
+    pub fn preset(quality: Quality) -> (u32, u32, u32) {
+        match quality {
+            Quality::Low => (32, 4, 1),
+            Quality::Medium => (64, 5, 1),
+            Quality::High => (96, 6, 2),
+            Quality::Ultra => (192, 8, 8),
+        }
+    }
+
+    /// The settings a scene asks for: its preset, overridden by explicit step counts.
+    pub fn from_scene(scene: &Scene) -> MarchSettings {
+        let r = &scene.render;
+        let (primary, light, spp) = Self::preset(r.quality);
+        let l = &scene.lighting;
+        MarchSettings {
+            primary_steps: r.primary_steps.unwrap_or(primary),
+            light_steps: r.light_steps.unwrap_or(light),
+            samples_per_pixel: r.samples_per_pixel.unwrap_or(spp),
+            octaves: l.octaves,
+            octave_factors: [l.octave_attenuation, l.octave_contribution, l.octave_eccentricity],
+            albedo: l.albedo,
+            ambient_scale: l.ambient_scale,
+            phase: PhaseLobes::from_scene(&scene.phase),
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct MarchUniform {
+    counts: UVec4,
+    octaves: Vec4,
+    phase: Vec4,
+    ambient: Vec4,
+    tile: UVec4,
+}
+
+/// Where the march reads and writes.
+pub struct RaymarchTargets<'a> {
+    /// The host's depth buffer (Depth32Float, 0 near, 1 far, from `Frame::clip_from_view`).
+    pub depth: &'a wgpu::TextureView,
+    /// Output, [`CLOUD_FORMAT`] with STORAGE_BINDING, the frame's size.
+    pub clouds: &'a wgpu::TextureView,
+}
+
+/// The ray-march pass.
+pub struct RaymarchRenderer {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    frame: wgpu::Buffer,
+    march: wgpu::Buffer,
+    settings: MarchUniform,
+}
+
+impl RaymarchRenderer {
+    /// Builds the pipeline against the field's bind group layout.
+    pub fn new(ctx: &GpuContext, field: &FieldGpu) -> RaymarchRenderer {
+        let depth = wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Depth,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        };
+        let layout = bind_group_layout(&ctx.device, "raymarch", &[UNIFORM, UNIFORM, depth, storage_texture_2d(CLOUD_FORMAT)]);
+        let pipeline = compute_pipeline(ctx, "raymarch", &shader_source(), "march_clouds", &[field.layout(), &layout]);
+        let buffer = |label, size| {
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        RaymarchRenderer {
+            pipeline,
+            layout,
+            frame: buffer("raymarch frame", size_of::<crate::frame::FrameUniform>() as u64),
+            march: buffer("raymarch settings", size_of::<MarchUniform>() as u64),
+            settings: MarchUniform::zeroed(),
+        }
+    }
+
+    /// Uploads the frame and settings for the next [`RaymarchRenderer::encode`].
+    pub fn prepare(&mut self, ctx: &GpuContext, frame: &Frame, settings: &MarchSettings) {
+        let [a, b, c] = settings.octave_factors;
+        self.settings = MarchUniform {
+            counts: UVec4::new(settings.primary_steps, settings.light_steps, settings.samples_per_pixel, settings.octaves),
+            octaves: Vec4::new(a, b, c, settings.albedo),
+            phase: Vec4::from_array(settings.phase.to_gpu()),
+            ambient: Vec4::new(settings.ambient_scale, 0.0, 0.0, 0.0),
+            tile: UVec4::ZERO,
+        };
+        ctx.queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame.uniform()));
+        ctx.queue.write_buffer(&self.march, 0, bytemuck::bytes_of(&self.settings));
+    }
+
+    /// Records the march over the pixel rectangle at `origin` of `size` pixels (the whole frame, or
+    /// one tile of it so long renders can report progress between submissions). A tile's origin is
+    /// uploaded now, so submit each tile before encoding the next.
+    pub fn encode(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        field: &FieldGpu,
+        targets: &RaymarchTargets,
+        (origin, size): (UVec2, UVec2),
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        if self.settings.tile.truncate().truncate() != origin {
+            self.settings.tile = origin.extend(0).extend(0);
+            ctx.queue.write_buffer(&self.march, 0, bytemuck::bytes_of(&self.settings));
+        }
+        let group = bind_group(&ctx.device, &self.layout, &[
+            self.frame.as_entire_binding(),
+            self.march.as_entire_binding(),
+            wgpu::BindingResource::TextureView(targets.depth),
+            wgpu::BindingResource::TextureView(targets.clouds),
+        ]);
+        dispatch_2d(encoder, "raymarch", &self.pipeline, &[field.bind_group(), &group], size, timestamps);
+    }
+}

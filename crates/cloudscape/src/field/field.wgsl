@@ -1,0 +1,189 @@
+// The cloud field on the GPU: the twin of field/mod.rs and field/layer.rs, line for line.
+// Everything it binds lives in bind group 0; techniques put their own resources in group 1+.
+
+struct FieldLayer {
+    shape: vec4<f32>,        // bottom_m, thickness_m, coverage, extinction_per_m
+    motion: vec4<f32>,       // wind east, wind south (m/s), weather offset u, v
+    noise_offset: vec4<f32>, // noise offset xyz (m), type coordinate at channel 0
+    type_bounds: vec4<f32>,  // channel values where the next type begins
+    type_steps: vec4<f32>,   // type-coordinate change at each bound
+}
+
+struct FieldVolume {
+    min_m: vec4<f32>,        // box minimum xyz (m), extinction_per_m where the grid is 1
+    size_m: vec4<f32>,       // box size xyz (m)
+    atlas_origin: vec4<f32>, // first texel of this grid in the atlas
+    resolution: vec4<f32>,   // grid size in texels
+}
+
+struct Field {
+    planet: vec4<f32>,     // radius_m, 1 if flat, lowest layer bottom_m, highest layer top_m
+    noise: vec4<f32>,      // base period m, detail period m, detail erosion, curl displacement m
+    weather: vec4<f32>,    // weather extent x, z (m), time_s
+    counts: vec4<u32>,     // layer count, volume count
+    atlas_size: vec4<f32>, // atlas texels xyz
+    layers: array<FieldLayer, 4>,
+    volumes: array<FieldVolume, 4>,
+}
+
+@group(0) @binding(0) var<uniform> field: Field;
+@group(0) @binding(1) var field_base_noise: texture_3d<f32>;
+@group(0) @binding(2) var field_detail_noise: texture_3d<f32>;
+@group(0) @binding(3) var field_curl_noise: texture_2d<f32>;
+@group(0) @binding(4) var field_weather_map: texture_2d<f32>;
+@group(0) @binding(5) var field_volume_atlas: texture_3d<f32>;
+@group(0) @binding(6) var field_repeat_linear: sampler;
+@group(0) @binding(7) var field_clamp_linear: sampler;
+
+const FIELD_NO_HIT: f32 = 3.0e38;
+
+// Unit "up" at p: the planet normal (or +y on a flat planet).
+fn field_up(p: vec3<f32>) -> vec3<f32> {
+    if field.planet.y > 0.5 {
+        return vec3<f32>(0.0, 1.0, 0.0);
+    }
+    return normalize(vec3<f32>(p.x, p.y + field.planet.x, p.z));
+}
+
+// Ray parameters (t0, t1) where the ray o + t d is below altitude `h` (inside the sphere of radius
+// R + h, or under the plane y = h); t0 > t1 when it never is.
+fn field_below(o: vec3<f32>, d: vec3<f32>, h: f32) -> vec2<f32> {
+    if field.planet.y > 0.5 {
+        if abs(d.y) < 1.0e-8 {
+            return select(vec2<f32>(1.0, -1.0), vec2<f32>(-FIELD_NO_HIT, FIELD_NO_HIT), o.y < h);
+        }
+        let t = (h - o.y) / d.y;
+        return select(vec2<f32>(t, FIELD_NO_HIT), vec2<f32>(-FIELD_NO_HIT, t), d.y > 0.0);
+    }
+    let r = field.planet.x;
+    let b = dot(o, d) + d.y * r;
+    // |o - c|^2 - (R + h)^2 without cancellation: |o|^2 + 2 o.y R - h (2 R + h).
+    let c = dot(o, o) + 2.0 * o.y * r - h * (2.0 * r + h);
+    let disc = b * b - c;
+    if disc < 0.0 {
+        return vec2<f32>(1.0, -1.0);
+    }
+    let s = sqrt(disc);
+    return vec2<f32>(-b - s, -b + s);
+}
+
+// Distance to the ground along the ray, or FIELD_NO_HIT without a ground.
+fn field_ground_distance(o: vec3<f32>, d: vec3<f32>, has_ground: bool) -> f32 {
+    if !has_ground {
+        return FIELD_NO_HIT;
+    }
+    let g = field_below(o, d, 0.0);
+    if g.x < g.y && g.y > 0.0 {
+        return max(g.x, 0.0);
+    }
+    return FIELD_NO_HIT;
+}
+
+fn field_remap(value: f32, lo0: f32, hi0: f32, lo1: f32, hi1: f32) -> f32 {
+    return lo1 + (value - lo0) * (hi1 - lo1) / (hi0 - lo0);
+}
+
+// Altitude above the ground (m); the cancellation-free sphere form of PlanetGeometry::altitude_m.
+fn field_altitude_m(p: vec3<f32>) -> f32 {
+    let r = field.planet.x;
+    if field.planet.y > 0.5 {
+        return p.y;
+    }
+    let to_centre = length(vec3<f32>(p.x, p.y + r, p.z));
+    return (dot(p, p) + 2.0 * p.y * r) / (to_centre + r);
+}
+
+fn field_height_gradient(type_coord: f32, f: f32) -> f32 {
+    let t = clamp(type_coord, 0.0, 3.0);
+    let lo = min(u32(floor(t)), 2u);
+    let w = t - f32(lo);
+    var gradients = array<vec4<f32>, 4>(
+        vec4<f32>(0.0, 0.07, 0.08, 0.15),
+        vec4<f32>(0.0, 0.2, 0.42, 0.6),
+        vec4<f32>(0.0, 0.08, 0.75, 1.0),
+        vec4<f32>(0.0, 0.05, 0.9, 1.0),
+    );
+    let g = gradients[lo] * (1.0 - w) + gradients[lo + 1u] * w;
+    let rise = clamp(field_remap(f, g.x, g.y, 0.0, 1.0), 0.0, 1.0);
+    let fall = clamp(field_remap(f, g.z, g.w, 1.0, 0.0), 0.0, 1.0);
+    return rise * fall;
+}
+
+fn field_type_coord(layer: FieldLayer, channel: f32) -> f32 {
+    let e = 0.05;
+    var t = layer.noise_offset.w;
+    for (var i = 0u; i < 3u; i++) {
+        t += layer.type_steps[i] * smoothstep(layer.type_bounds[i] - e, layer.type_bounds[i] + e, channel);
+    }
+    return t;
+}
+
+fn field_apply_coverage(shape: f32, coverage: f32, type_coord: f32, f: f32) -> f32 {
+    let anvil = clamp(type_coord - 2.0, 0.0, 1.0);
+    let exponent = field_remap(clamp(f, 0.7, 0.8), 0.7, 0.8, 1.0, mix(1.0, 0.5, anvil));
+    let c = pow(coverage, exponent);
+    if c <= 0.0 {
+        return 0.0;
+    }
+    return field_remap(shape, 1.0 - c, 1.0, 0.0, 1.0) * c;
+}
+
+fn field_erode(density: f32, detail: vec4<f32>, f: f32, erosion: f32) -> f32 {
+    let fbm = detail.x * 0.625 + detail.y * 0.25 + detail.z * 0.125;
+    let modifier = mix(fbm, 1.0 - fbm, clamp(f * 10.0, 0.0, 1.0));
+    return clamp(field_remap(density, modifier * erosion, 1.0, 0.0, 1.0), 0.0, 1.0);
+}
+
+fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32) -> f32 {
+    let f = (h - layer.shape.x) / layer.shape.y;
+    if f < 0.0 || f > 1.0 {
+        return 0.0;
+    }
+    let wind = layer.motion.xy * field.weather.z;
+    let xz = p.xz - wind;
+    let w = textureSampleLevel(field_weather_map, field_repeat_linear, xz / field.weather.xy + layer.motion.zw, 0.0);
+    let coverage = clamp(w.x + 2.0 * layer.shape.z - 1.0, 0.0, 1.0);
+    if coverage <= 0.0 {
+        return 0.0;
+    }
+    let type_coord = field_type_coord(layer, w.y);
+    let gradient = field_height_gradient(type_coord, f);
+    if gradient <= 0.0 {
+        return 0.0;
+    }
+    let q = p - vec3<f32>(wind.x, 0.0, wind.y) + layer.noise_offset.xyz;
+    let base = textureSampleLevel(field_base_noise, field_repeat_linear, q / field.noise.x, 0.0);
+    let fbm = base.y * 0.625 + base.z * 0.25 + base.w * 0.125;
+    let shaped = field_remap(base.x, fbm - 1.0, 1.0, 0.0, 1.0) * gradient;
+    let covered = field_apply_coverage(shaped, coverage, type_coord, f);
+    if covered <= 0.0 {
+        return 0.0;
+    }
+    let curl = textureSampleLevel(field_curl_noise, field_repeat_linear, q.xz / field.noise.x, 0.0);
+    let swirl = (curl.xy * 2.0 - 1.0) * field.noise.w * (1.0 - f);
+    let detail = textureSampleLevel(field_detail_noise, field_repeat_linear, (q + vec3<f32>(swirl.x, 0.0, swirl.y)) / field.noise.y, 0.0);
+    return field_erode(covered, detail, f, field.noise.z) * w.z * layer.shape.w;
+}
+
+fn field_volume_extinction(v: FieldVolume, p: vec3<f32>) -> f32 {
+    let uvw = (p - v.min_m.xyz) / v.size_m.xyz;
+    if any(uvw < vec3<f32>(0.0)) || any(uvw > vec3<f32>(1.0)) {
+        return 0.0;
+    }
+    let texel = clamp(uvw * v.resolution.xyz, vec3<f32>(0.5), v.resolution.xyz - 0.5);
+    let atlas_uvw = (v.atlas_origin.xyz + texel) / field.atlas_size.xyz;
+    return textureSampleLevel(field_volume_atlas, field_clamp_linear, atlas_uvw, 0.0).x * v.min_m.w;
+}
+
+// Extinction sigma_t (m^-1) at world point p (m) at the field's time: CloudField::extinction_per_m.
+fn field_extinction(p: vec3<f32>) -> f32 {
+    let h = field_altitude_m(p);
+    var sigma_t = 0.0;
+    for (var i = 0u; i < field.counts.x; i++) {
+        sigma_t += field_layer_extinction(field.layers[i], p, h);
+    }
+    for (var i = 0u; i < field.counts.y; i++) {
+        sigma_t += field_volume_extinction(field.volumes[i], p);
+    }
+    return sigma_t;
+}

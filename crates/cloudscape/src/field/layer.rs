@@ -1,0 +1,112 @@
+//! One cloud layer's parameters as the density function uses them, and the shaping steps of
+//! Schneider 2015 ("The Real-time Volumetric Cloudscapes of Horizon Zero Dawn") and Schneider 2017
+//! ("Nubis: Authoring Real-Time Volumetric Cloudscapes with the Decima Engine").
+
+use super::noise::{hash_to_unit, lerp, pcg_hash, remap};
+use super::profile::TypeTable;
+use crate::scene::CloudLayer;
+use glam::{Vec2, Vec3, Vec4};
+
+/// A layer ready for density evaluation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LayerField {
+    /// Altitude of the bottom, metres.
+    pub bottom_m: f32,
+    /// Thickness, metres.
+    pub thickness_m: f32,
+    /// Scene coverage 0..1.
+    pub coverage: f32,
+    /// Extinction of the densest cloud, m^-1.
+    pub extinction_per_m: f32,
+    /// The type mix as a lookup from the weather type channel.
+    pub types: TypeTable,
+    /// Wind, m/s, (east, south).
+    pub wind_m_per_s: Vec2,
+    /// Offset into the weather map (in map units) that decorrelates layers.
+    pub weather_offset: Vec2,
+    /// Offset into the noise (metres) that decorrelates layers.
+    pub noise_offset_m: Vec3,
+}
+
+impl LayerField {
+    /// The layer of a scene entry; its offsets come from hashing `noise_seed`.
+    pub fn new(layer: &CloudLayer) -> LayerField {
+        let unit = |k: u32| hash_to_unit(pcg_hash(layer.noise_seed.wrapping_mul(4).wrapping_add(k)));
+        LayerField {
+            bottom_m: layer.bottom_m,
+            thickness_m: layer.thickness_m,
+            coverage: layer.coverage,
+            extinction_per_m: layer.extinction_per_m,
+            types: TypeTable::from_mix(&layer.types),
+            wind_m_per_s: Vec2::from_array(layer.wind_m_per_s),
+            weather_offset: Vec2::new(unit(0), unit(1)),
+            noise_offset_m: Vec3::new(unit(2), unit(3), unit(2) * 0.5) * 1.0e4,
+        }
+    }
+
+    /// Local coverage from the weather map's coverage channel: the scene coverage shifts the map,
+    /// `saturate(map + 2 coverage - 1)`, so 0 clears the layer, 0.5 keeps the map and 1 fills it.
+    pub fn local_coverage(&self, map_coverage: f32) -> f32 {
+        (map_coverage + 2.0 * self.coverage - 1.0).clamp(0.0, 1.0)
+    }
+}
+
+/// Low-frequency cloud shape from the base texel: the Perlin-Worley channel remapped by the Worley
+/// fBm of the other three, `remap(R, fbm - 1, 1, 0, 1)` with fbm = 0.625 G + 0.25 B + 0.125 A
+/// (Schneider 2015).
+pub fn base_shape(base: Vec4) -> f32 {
+    let fbm = base.y * 0.625 + base.z * 0.25 + base.w * 0.125;
+    remap(base.x, fbm - 1.0, 1.0, 0.0, 1.0)
+}
+
+/// Coverage applied to the shaped base, `remap(shape, 1 - c, 1, 0, 1) * c` (Schneider 2015), with the
+/// cumulonimbus anvil bias that widens coverage near the top, `c^remap(f, 0.7, 0.8, 1, lerp(1, 0.5,
+/// anvil))` (Schneider 2017), `anvil` growing from type 2 (cumulus) to 3 (cumulonimbus).
+pub fn apply_coverage(shape: f32, coverage: f32, type_coord: f32, f: f32) -> f32 {
+    let anvil = (type_coord - 2.0).clamp(0.0, 1.0);
+    let exponent = remap(f.clamp(0.7, 0.8), 0.7, 0.8, 1.0, lerp(1.0, 0.5, anvil));
+    let c = coverage.powf(exponent);
+    if c <= 0.0 {
+        return 0.0;
+    }
+    remap(shape, 1.0 - c, 1.0, 0.0, 1.0) * c
+}
+
+/// Detail erosion (Schneider 2015): the detail fBm, inverted from wispy at the base to billowy
+/// above 10 % of the layer, is subtracted through `remap(density, detail * erosion, 1, 0, 1)`.
+pub fn erode(density: f32, detail: Vec4, f: f32, erosion: f32) -> f32 {
+    let fbm = detail.x * 0.625 + detail.y * 0.25 + detail.z * 0.125;
+    let modifier = lerp(fbm, 1.0 - fbm, (f * 10.0).clamp(0.0, 1.0));
+    remap(density, modifier * erosion, 1.0, 0.0, 1.0).clamp(0.0, 1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coverage_zero_and_one_are_clear_and_full() {
+        let l = LayerField::new(&CloudLayer { coverage: 0.0, ..CloudLayer::default() });
+        assert_eq!(l.local_coverage(1.0), 0.0);
+        let l = LayerField::new(&CloudLayer { coverage: 1.0, ..CloudLayer::default() });
+        assert_eq!(l.local_coverage(0.0), 1.0);
+        assert_eq!(apply_coverage(0.7, 0.0, 2.0, 0.5), 0.0);
+        assert!((apply_coverage(0.7, 1.0, 2.0, 0.5) - 0.7).abs() < 1e-6);
+    }
+
+    #[test]
+    fn anvil_widens_only_cumulonimbus_tops() {
+        let (shape, c) = (0.6, 0.5);
+        assert_eq!(apply_coverage(shape, c, 2.0, 0.9), apply_coverage(shape, c, 2.0, 0.5));
+        assert!(apply_coverage(shape, c, 3.0, 0.9) > apply_coverage(shape, c, 3.0, 0.5));
+    }
+
+    #[test]
+    fn erosion_only_removes() {
+        let detail = Vec4::new(0.8, 0.6, 0.4, 1.0);
+        for d in [0.05, 0.3, 0.9] {
+            assert!(erode(d, detail, 0.5, 0.35) <= d + 1e-6);
+        }
+        assert_eq!(erode(0.5, detail, 0.5, 0.0), 0.5);
+    }
+}

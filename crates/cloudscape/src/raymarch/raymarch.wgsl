@@ -1,0 +1,173 @@
+// Ray-marched clouds: per pixel, in-scattered radiance and transmittance of the cloud field along
+// the view ray, up to the host's depth buffer. Needs field.wgsl, frame.wgsl and optics/phase.wgsl.
+
+struct March {
+    counts: vec4<u32>,  // primary steps, light steps, samples per pixel, octaves
+    octaves: vec4<f32>, // attenuation a, contribution b, eccentricity c, single-scattering albedo
+    phase: vec4<f32>,   // phase lobes (optics::PhaseLobes::to_gpu)
+    ambient: vec4<f32>, // ambient scale
+    tile: vec4<u32>,    // origin of the pixel tile this dispatch covers
+}
+
+@group(1) @binding(0) var<uniform> frame: Frame;
+@group(1) @binding(1) var<uniform> march: March;
+@group(1) @binding(2) var host_depth: texture_depth_2d;
+@group(1) @binding(3) var cloud_out: texture_storage_2d<rgba16float, write>;
+
+// Rays stop once this little light gets through (VolumeCloud's threshold, peers.md).
+const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
+
+// The first stretch of the ray, within [0, t_max], inside the layers' altitude band.
+fn march_layer_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
+    if field.counts.x == 0u {
+        return vec2<f32>(1.0, -1.0);
+    }
+    let outer = field_below(o, d, field.planet.w);
+    let inner = field_below(o, d, field.planet.z);
+    var t0 = max(outer.x, 0.0);
+    var t1 = min(outer.y, t_max);
+    if inner.x < inner.y {
+        if inner.x <= t0 && inner.y > t0 {
+            t0 = inner.y; // starts below the layer: enter where the ray rises out of the inner ball
+        } else if inner.x > t0 {
+            t1 = min(t1, inner.x); // from above or inside: stop where the ray sinks below the layer
+        }
+    }
+    return vec2<f32>(t0, t1);
+}
+
+// The hull of the ray's stretches inside the voxel-grid boxes.
+fn march_volume_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
+    var hull = vec2<f32>(FIELD_NO_HIT, -FIELD_NO_HIT);
+    for (var i = 0u; i < field.counts.y; i++) {
+        let v = field.volumes[i];
+        let inv = 1.0 / d;
+        let a = (v.min_m.xyz - o) * inv;
+        let b = (v.min_m.xyz + v.size_m.xyz - o) * inv;
+        let t0 = max(max(max(min(a.x, b.x), min(a.y, b.y)), min(a.z, b.z)), 0.0);
+        let t1 = min(min(min(max(a.x, b.x), max(a.y, b.y)), max(a.z, b.z)), t_max);
+        if t0 < t1 {
+            hull = vec2<f32>(min(hull.x, t0), max(hull.y, t1));
+        }
+    }
+    return hull;
+}
+
+// Optical depth toward the sun from p: `light_steps` segments whose lengths double, covering the way
+// to the top of the layers (at most 8 km), each sampled at a jittered point (VolumeCloud samples the
+// sun path at 0.5, 1.5, 3, 6, 12 units with weights 1, 1, 2, 4, 8; peers.md).
+fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
+    let sun = frame.sun_direction.xyz;
+    var length_m = 8000.0;
+    if field.counts.x > 0u {
+        length_m = clamp(field_below(p, sun, field.planet.w).y, 50.0, 8000.0);
+    }
+    let n = march.counts.y;
+    let unit = length_m / f32((1u << n) - 1u);
+    var tau = 0.0;
+    var start = 0.0;
+    for (var k = 0u; k < n; k++) {
+        let width = unit * f32(1u << k);
+        tau += field_extinction(p + sun * (start + width * jitter)) * width;
+        start += width;
+    }
+    return tau;
+}
+
+// Light scattered from the sky above and the ground below, per unit sigma_s: each hemisphere
+// contributes half its mean radiance (isotropic estimate), dimmed by the optical depth to the top
+// (bottom) of the layer estimated from one sample halfway, with multiple scattering's softer
+// attenuation exp(-a tau) (Wrenninge 2013's octave factor a).
+fn march_ambient(p: vec3<f32>, h: f32) -> vec3<f32> {
+    let up = field_up(p);
+    let a = march.octaves.x;
+    var above = 500.0;
+    var below = 500.0;
+    if field.counts.x > 0u && h >= field.planet.z && h <= field.planet.w {
+        above = field.planet.w - h;
+        below = h - field.planet.z;
+    }
+    let tau_up = field_extinction(p + up * (0.5 * above)) * above;
+    let tau_down = field_extinction(p - up * (0.5 * below)) * below;
+    var ground = frame.ground_radiance.xyz;
+    if frame.ground_albedo.w < 0.5 {
+        ground = frame.sky_horizon.xyz;
+    }
+    let sky = frame.sky_mean_up.xyz;
+    return march.ambient.x * 0.5 * (sky * exp(-a * tau_up) + ground * exp(-a * tau_down));
+}
+
+// Sun light scattered toward the eye per unit sigma_s, with multiple-scattering octaves
+// (Wrenninge 2013): sum_i b^i p(c^i g, mu) exp(-a^i tau_sun) E_sun.
+fn march_sun_scattering(cos_theta: f32, tau_sun: f32) -> vec3<f32> {
+    var sum = 0.0;
+    var weight = 1.0;
+    var extinction = 1.0;
+    var anisotropy = 1.0;
+    for (var i = 0u; i < march.counts.w; i++) {
+        sum += weight * phase_eval(phase_scaled(march.phase, anisotropy), cos_theta) * exp(-extinction * tau_sun);
+        weight *= march.octaves.y;
+        extinction *= march.octaves.x;
+        anisotropy *= march.octaves.z;
+    }
+    return sum * frame.sun_irradiance.xyz;
+}
+
+// Integrates [t0, t1] in `primary_steps` equal steps offset by `jitter`, with Hillaire 2016's
+// energy-conserving step: S_int = (S - S exp(-sigma_t dt)) / sigma_t; L += T S_int; T *= exp(-sigma_t dt).
+fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32) -> vec4<f32> {
+    let n = march.counts.x;
+    let dt = (t1 - t0) / f32(n);
+    let cos_theta = dot(d, frame.sun_direction.xyz);
+    let albedo = march.octaves.w;
+    var radiance = vec3<f32>(0.0);
+    var transmittance = 1.0;
+    for (var i = 0u; i < n; i++) {
+        let p = o + d * (t0 + (f32(i) + jitter) * dt);
+        let sigma_t = field_extinction(p);
+        if sigma_t <= 0.0 {
+            continue;
+        }
+        let h = field_altitude_m(p);
+        let tau_sun = march_sun_optical_depth(p, jitter);
+        let source = albedo * (march_sun_scattering(cos_theta, tau_sun) + march_ambient(p, h));
+        let step_transmittance = exp(-sigma_t * dt);
+        radiance += transmittance * source * (1.0 - step_transmittance);
+        transmittance *= step_transmittance;
+        if transmittance < MARCH_MIN_TRANSMITTANCE {
+            break;
+        }
+    }
+    return vec4<f32>(radiance, transmittance);
+}
+
+@compute @workgroup_size(8, 8)
+fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
+    let px = id.xy + march.tile.xy;
+    if px.x >= u32(frame.viewport.x) || px.y >= u32(frame.viewport.y) {
+        return;
+    }
+    let pixel = vec2<f32>(px) + 0.5;
+    let o = frame.camera_position.xyz;
+    let d = frame_ray_direction(frame, pixel);
+    let depth = textureLoad(host_depth, vec2<i32>(px), 0);
+    var t_max = min(frame.camera_position.w, field_ground_distance(o, d, frame.ground_albedo.w > 0.5));
+    if depth < 1.0 {
+        t_max = min(t_max, frame_depth_distance(frame, pixel, depth));
+    }
+    let layer = march_layer_interval(o, d, t_max);
+    let volume = march_volume_interval(o, d, t_max);
+    let t0 = min(select(FIELD_NO_HIT, layer.x, layer.x < layer.y), volume.x);
+    let t1 = max(select(-FIELD_NO_HIT, layer.y, layer.x < layer.y), volume.y);
+    var result = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    if t0 < t1 {
+        let spp = march.counts.z;
+        var sum = vec4<f32>(0.0);
+        for (var s = 0u; s < spp; s++) {
+            let jitter = frame_pixel_jitter(pixel, frame.viewport.w * f32(spp) + f32(s));
+            sum += march_segment(o, d, t0, t1, jitter);
+        }
+        result = sum / f32(spp);
+    }
+    textureStore(cloud_out, vec2<i32>(px), result);
+}
