@@ -170,7 +170,10 @@ pub struct Ground {
 
 impl Default for Ground {
     fn default() -> Self {
-        Ground { enabled: true, albedo: [0.12, 0.13, 0.10] }
+        Ground {
+            enabled: true,
+            albedo: [0.12, 0.13, 0.10],
+        }
     }
 }
 
@@ -196,7 +199,10 @@ pub struct Planet {
 
 impl Default for Planet {
     fn default() -> Self {
-        Planet { shape: PlanetShape::Spherical, radius_m: 6_360_000.0 }
+        Planet {
+            shape: PlanetShape::Spherical,
+            radius_m: 6_360_000.0,
+        }
     }
 }
 
@@ -218,12 +224,20 @@ pub struct CloudTypeMix {
 impl Default for CloudTypeMix {
     /// All zero: a table that names some types leaves the others out.
     fn default() -> Self {
-        CloudTypeMix { stratus: 0.0, stratocumulus: 0.0, cumulus: 0.0, cumulonimbus: 0.0 }
+        CloudTypeMix {
+            stratus: 0.0,
+            stratocumulus: 0.0,
+            cumulus: 0.0,
+            cumulonimbus: 0.0,
+        }
     }
 }
 
 fn cumulus_only() -> CloudTypeMix {
-    CloudTypeMix { cumulus: 1.0, ..CloudTypeMix::default() }
+    CloudTypeMix {
+        cumulus: 1.0,
+        ..CloudTypeMix::default()
+    }
 }
 
 /// One layer of clouds between two altitudes.

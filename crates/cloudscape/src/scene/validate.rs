@@ -1,0 +1,430 @@
+//! Range checks of every numeric field, in one table per struct, and the checks between fields.
+//!
+//! The ranges restate the doc comments of [`super::model`]; change both together. Seeds are not
+//! listed: every `u32` is a valid seed.
+
+use std::fmt;
+
+use super::model::{CloudLayer, Scene, VolumeGrid, WeatherSource};
+
+/// A value that breaks a rule, by dotted key path.
+#[derive(Debug)]
+pub(super) struct Violation {
+    /// Dotted key path, e.g. `layers.0.coverage`.
+    pub key: String,
+    /// What is wrong and what is allowed.
+    pub message: String,
+}
+
+/// Checks every field of `scene` and every relation between fields; the first violation found.
+pub(super) fn validate(scene: &Scene) -> Result<(), Violation> {
+    check(scene, "", SCENE_RULES, SCENE_RELATIONS)?;
+    for (index, layer) in scene.layers.iter().enumerate() {
+        check(
+            layer,
+            &format!("layers.{index}."),
+            LAYER_RULES,
+            LAYER_RELATIONS,
+        )?;
+    }
+    for (index, volume) in scene.volumes.iter().enumerate() {
+        check(
+            volume,
+            &format!("volumes.{index}."),
+            VOLUME_RULES,
+            VOLUME_RELATIONS,
+        )?;
+    }
+    Ok(())
+}
+
+/// The allowed values of a numeric field; every allowed value is also finite.
+#[derive(Clone, Copy, Debug)]
+enum Allowed {
+    /// Any finite number.
+    Finite,
+    /// `min..=max`.
+    Between(f32, f32),
+    /// `>= min`.
+    AtLeast(f32),
+    /// `> min`.
+    Above(f32),
+}
+
+impl Allowed {
+    fn contains(self, value: f64) -> bool {
+        match self {
+            Allowed::Finite => true,
+            Allowed::Between(min, max) => f64::from(min) <= value && value <= f64::from(max),
+            Allowed::AtLeast(min) => f64::from(min) <= value,
+            Allowed::Above(min) => f64::from(min) < value,
+        }
+    }
+
+    /// The range in words, with its unit: `1..179 deg`, `>= 0`, `any finite number (m)`.
+    fn describe(self, unit: &str) -> String {
+        let range = match self {
+            Allowed::Finite => "any finite number".to_string(),
+            Allowed::Between(min, max) => format!("{min}..{max}"),
+            Allowed::AtLeast(min) => format!(">= {min}"),
+            Allowed::Above(min) => format!("> {min}"),
+        };
+        match (self, unit) {
+            (_, "") => range,
+            (Allowed::Finite, _) => format!("{range} ({unit})"),
+            _ => format!("{range} {unit}"),
+        }
+    }
+}
+
+/// A numeric field as read from the scene.
+enum Field<'a> {
+    Float(f32),
+    Int(u32),
+    /// An array: each element is checked, and named by its index.
+    Floats(&'a [f32]),
+    /// An optional field that is not set.
+    Absent,
+}
+
+fn optional_floats(value: &Option<[f32; 3]>) -> Field<'_> {
+    value.as_ref().map_or(Field::Absent, |v| Field::Floats(v))
+}
+
+fn optional_int(value: Option<u32>) -> Field<'static> {
+    value.map_or(Field::Absent, Field::Int)
+}
+
+/// One row of a table: a field, its allowed values and its unit.
+struct Rule<T> {
+    /// Dotted key path relative to `T`.
+    key: &'static str,
+    allowed: Allowed,
+    /// Unit for messages; empty for dimensionless fields.
+    unit: &'static str,
+    read: fn(&T) -> Field<'_>,
+}
+
+/// Shorthand that keeps each row of the tables on one line.
+const fn rule<T>(
+    key: &'static str,
+    allowed: Allowed,
+    unit: &'static str,
+    read: fn(&T) -> Field<'_>,
+) -> Rule<T> {
+    Rule {
+        key,
+        allowed,
+        unit,
+        read,
+    }
+}
+
+/// A check between fields of `T`; `broken` returns the message when the check fails.
+struct Relation<T> {
+    /// Dotted key path (relative to `T`) of the field the message is about.
+    key: &'static str,
+    broken: fn(&T) -> Option<String>,
+}
+
+use Allowed::{Above, AtLeast, Between, Finite};
+use Field::{Float, Floats, Int};
+
+#[rustfmt::skip]
+const SCENE_RULES: &[Rule<Scene>] = &[
+    rule("camera.position_m", Finite, "m", |s| Floats(&s.camera.position_m)),
+    rule("camera.look_at_m", Finite, "m", |s| optional_floats(&s.camera.look_at_m)),
+    rule("camera.yaw_deg", Finite, "deg", |s| Float(s.camera.yaw_deg)),
+    rule("camera.pitch_deg", Between(-90.0, 90.0), "deg", |s| Float(s.camera.pitch_deg)),
+    rule("camera.fov_y_deg", Between(1.0, 179.0), "deg", |s| Float(s.camera.fov_y_deg)),
+    rule("camera.near_m", Above(0.0), "m", |s| Float(s.camera.near_m)),
+    rule("camera.far_m", Above(0.0), "m", |s| Float(s.camera.far_m)),
+    rule("sun.elevation_deg", Between(-90.0, 90.0), "deg", |s| Float(s.sun.elevation_deg)),
+    rule("sun.azimuth_deg", Finite, "deg", |s| Float(s.sun.azimuth_deg)),
+    rule("sun.irradiance", AtLeast(0.0), "", |s| Float(s.sun.irradiance)),
+    rule("sun.color", Between(0.0, 1.0), "", |s| Floats(&s.sun.color)),
+    rule("sun.angular_radius_deg", Between(0.0, 5.0), "deg", |s| Float(s.sun.angular_radius_deg)),
+    rule("sky.radiance", AtLeast(0.0), "", |s| Floats(&s.sky.radiance)),
+    rule("sky.zenith_radiance", AtLeast(0.0), "", |s| Floats(&s.sky.zenith_radiance)),
+    rule("sky.horizon_radiance", AtLeast(0.0), "", |s| Floats(&s.sky.horizon_radiance)),
+    rule("sky.gradient_exponent", Between(0.05, 10.0), "", |s| Float(s.sky.gradient_exponent)),
+    rule("ground.albedo", Between(0.0, 1.0), "", |s| Floats(&s.ground.albedo)),
+    rule("planet.radius_m", Between(1.0e3, 1.0e8), "m", |s| Float(s.planet.radius_m)),
+    rule("weather.extent_km", Between(0.1, 1.0e4), "km", |s| Float(s.weather.extent_km)),
+    rule("weather.resolution", Between(8.0, 4096.0), "texels", |s| Int(s.weather.resolution)),
+    rule("weather.feature_size_km", Above(0.0), "km", |s| Float(s.weather.feature_size_km)),
+    rule("noise.base_period_m", Above(0.0), "m", |s| Float(s.noise.base_period_m)),
+    rule("noise.detail_period_m", Above(0.0), "m", |s| Float(s.noise.detail_period_m)),
+    rule("noise.detail_erosion", Between(0.0, 1.0), "", |s| Float(s.noise.detail_erosion)),
+    rule("noise.curl_displacement_m", AtLeast(0.0), "m", |s| Float(s.noise.curl_displacement_m)),
+    rule("phase.droplet_diameter_um", Between(5.0, 50.0), "um", |s| Float(s.phase.droplet_diameter_um)),
+    rule("phase.g", Between(-0.99, 0.99), "", |s| Float(s.phase.g)),
+    rule("phase.g_forward", Between(-0.99, 0.99), "", |s| Float(s.phase.g_forward)),
+    rule("phase.g_back", Between(-0.99, 0.99), "", |s| Float(s.phase.g_back)),
+    rule("phase.forward_weight", Between(0.0, 1.0), "", |s| Float(s.phase.forward_weight)),
+    rule("lighting.albedo", Between(0.0, 1.0), "", |s| Float(s.lighting.albedo)),
+    rule("lighting.octaves", Between(1.0, 8.0), "", |s| Int(s.lighting.octaves)),
+    rule("lighting.octave_attenuation", Between(0.0, 1.0), "", |s| Float(s.lighting.octave_attenuation)),
+    rule("lighting.octave_contribution", Between(0.0, 1.0), "", |s| Float(s.lighting.octave_contribution)),
+    rule("lighting.octave_eccentricity", Between(0.0, 1.0), "", |s| Float(s.lighting.octave_eccentricity)),
+    rule("lighting.ambient_scale", Between(0.0, 4.0), "", |s| Float(s.lighting.ambient_scale)),
+    rule("render.width", AtLeast(1.0), "px", |s| Int(s.render.width)),
+    rule("render.height", AtLeast(1.0), "px", |s| Int(s.render.height)),
+    rule("render.primary_steps", Between(1.0, 4096.0), "", |s| optional_int(s.render.primary_steps)),
+    rule("render.light_steps", Between(1.0, 64.0), "", |s| optional_int(s.render.light_steps)),
+    rule("render.samples_per_pixel", Between(1.0, 1024.0), "", |s| optional_int(s.render.samples_per_pixel)),
+    rule("render.exposure_ev", Between(-20.0, 20.0), "EV", |s| Float(s.render.exposure_ev)),
+    rule("render.time_s", Finite, "s", |s| Float(s.render.time_s)),
+];
+
+#[rustfmt::skip]
+const LAYER_RULES: &[Rule<CloudLayer>] = &[
+    rule("bottom_m", AtLeast(0.0), "m", |l| Float(l.bottom_m)),
+    rule("thickness_m", Between(10.0, 20_000.0), "m", |l| Float(l.thickness_m)),
+    rule("coverage", Between(0.0, 1.0), "", |l| Float(l.coverage)),
+    rule("extinction_per_m", Between(0.0, 1.0), "m^-1", |l| Float(l.extinction_per_m)),
+    rule("types.stratus", AtLeast(0.0), "", |l| Float(l.types.stratus)),
+    rule("types.stratocumulus", AtLeast(0.0), "", |l| Float(l.types.stratocumulus)),
+    rule("types.cumulus", AtLeast(0.0), "", |l| Float(l.types.cumulus)),
+    rule("types.cumulonimbus", AtLeast(0.0), "", |l| Float(l.types.cumulonimbus)),
+    rule("wind_m_per_s", Finite, "m/s", |l| Floats(&l.wind_m_per_s)),
+];
+
+#[rustfmt::skip]
+const VOLUME_RULES: &[Rule<VolumeGrid>] = &[
+    rule("center_m", Finite, "m", |v| Floats(&v.center_m)),
+    rule("size_m", Above(0.0), "m", |v| Floats(&v.size_m)),
+    rule("extinction_per_m", Between(0.0, 10.0), "m^-1", |v| Float(v.extinction_per_m)),
+];
+
+#[rustfmt::skip]
+const SCENE_RELATIONS: &[Relation<Scene>] = &[
+    Relation { key: "camera.far_m", broken: far_not_beyond_near },
+    Relation { key: "camera.look_at_m", broken: look_at_is_the_eye },
+    Relation { key: "weather.source", broken: weather_file_without_path },
+    Relation { key: "render.output", broken: output_not_png_or_exr },
+];
+
+#[rustfmt::skip]
+const LAYER_RELATIONS: &[Relation<CloudLayer>] = &[
+    Relation { key: "types", broken: no_cloud_type },
+];
+
+#[rustfmt::skip]
+const VOLUME_RELATIONS: &[Relation<VolumeGrid>] = &[
+    Relation { key: "path", broken: volume_without_path },
+];
+
+fn far_not_beyond_near(scene: &Scene) -> Option<String> {
+    let (near, far) = (scene.camera.near_m, scene.camera.far_m);
+    (far <= near).then(|| format!("far_m ({far} m) must be greater than near_m ({near} m)"))
+}
+
+fn look_at_is_the_eye(scene: &Scene) -> Option<String> {
+    (scene.camera.look_at_m == Some(scene.camera.position_m)).then(|| {
+        "look_at_m equals position_m, which gives no view direction; move it, or remove it to use yaw_deg \
+         and pitch_deg"
+            .to_string()
+    })
+}
+
+fn weather_file_without_path(scene: &Scene) -> Option<String> {
+    let has_path = scene
+        .weather
+        .path
+        .as_deref()
+        .is_some_and(|p| !p.trim().is_empty());
+    (scene.weather.source == WeatherSource::File && !has_path).then(|| {
+        "source = \"file\" needs `path`, a PNG file relative to the scene file".to_string()
+    })
+}
+
+fn output_not_png_or_exr(scene: &Scene) -> Option<String> {
+    let output = &scene.render.output;
+    let lower = output.to_ascii_lowercase();
+    (!lower.ends_with(".png") && !lower.ends_with(".exr")).then(|| {
+        format!("\"{output}\" must end in .png (tone-mapped sRGB) or .exr (linear HDR radiance)")
+    })
+}
+
+fn no_cloud_type(layer: &CloudLayer) -> Option<String> {
+    let t = &layer.types;
+    (t.stratus + t.stratocumulus + t.cumulus + t.cumulonimbus <= 0.0).then(|| {
+        "every type weight (stratus, stratocumulus, cumulus, cumulonimbus) is 0; at least one must be > 0"
+            .to_string()
+    })
+}
+
+fn volume_without_path(volume: &VolumeGrid) -> Option<String> {
+    volume.path.trim().is_empty().then(|| {
+        "a volume needs `path`, a Mitsuba 3 .vol file relative to the scene file".to_string()
+    })
+}
+
+/// Runs the rules, then the relations, of one item whose keys start with `prefix`.
+fn check<T>(
+    item: &T,
+    prefix: &str,
+    rules: &[Rule<T>],
+    relations: &[Relation<T>],
+) -> Result<(), Violation> {
+    for rule in rules {
+        rule.check(item, prefix)?;
+    }
+    for relation in relations {
+        if let Some(message) = (relation.broken)(item) {
+            return Err(Violation {
+                key: format!("{prefix}{}", relation.key),
+                message,
+            });
+        }
+    }
+    Ok(())
+}
+
+impl<T> Rule<T> {
+    fn check(&self, item: &T, prefix: &str) -> Result<(), Violation> {
+        let key = format!("{prefix}{}", self.key);
+        match (self.read)(item) {
+            Field::Float(value) => self.check_number(key, f64::from(value), &value),
+            Field::Int(value) => self.check_number(key, f64::from(value), &value),
+            Field::Floats(values) => values.iter().enumerate().try_for_each(|(index, value)| {
+                self.check_number(format!("{key}.{index}"), f64::from(*value), value)
+            }),
+            Field::Absent => Ok(()),
+        }
+    }
+
+    fn check_number(
+        &self,
+        key: String,
+        value: f64,
+        shown: &dyn fmt::Display,
+    ) -> Result<(), Violation> {
+        let problem = if !value.is_finite() {
+            "is not a finite number"
+        } else if !self.allowed.contains(value) {
+            "is out of range"
+        } else {
+            return Ok(());
+        };
+        Err(Violation {
+            key,
+            message: format!(
+                "{shown} {problem}; allowed {}",
+                self.allowed.describe(self.unit)
+            ),
+        })
+    }
+}
+
+#[cfg(test)]
+pub(super) mod tests {
+    use super::*;
+    use crate::scene::model::VolumeGrid;
+
+    /// A scene with every optional field set and one volume, so serialising it names every key.
+    pub(in crate::scene) fn fully_populated() -> Scene {
+        let mut scene = Scene::default();
+        scene.camera.look_at_m = Some([0.0, 2500.0, -6000.0]);
+        scene.weather.path = Some("weather.png".into());
+        scene.render.primary_steps = Some(128);
+        scene.render.light_steps = Some(6);
+        scene.render.samples_per_pixel = Some(4);
+        scene.volumes.push(VolumeGrid {
+            path: "cloud.vol".into(),
+            ..VolumeGrid::default()
+        });
+        scene
+    }
+
+    /// Dotted paths of the numeric leaves of a TOML value; array-of-table indices are left out.
+    fn numeric_keys(value: &toml::Value, prefix: &str, out: &mut Vec<String>) {
+        match value {
+            toml::Value::Table(table) => {
+                for (key, child) in table {
+                    numeric_keys(child, &format!("{prefix}{key}."), out);
+                }
+            }
+            toml::Value::Array(items) if items.iter().all(toml::Value::is_table) => {
+                items
+                    .iter()
+                    .for_each(|item| numeric_keys(item, prefix, out));
+            }
+            toml::Value::Array(_) | toml::Value::Integer(_) | toml::Value::Float(_) => {
+                out.push(prefix.trim_end_matches('.').to_string());
+            }
+            _ => {}
+        }
+    }
+
+    #[test]
+    fn every_numeric_field_except_seeds_has_exactly_one_rule() {
+        let serialized = toml::Value::try_from(fully_populated()).unwrap();
+        let mut fields = Vec::new();
+        numeric_keys(&serialized, "", &mut fields);
+        fields.retain(|key| !key.ends_with("seed"));
+        fields.sort();
+        fields.dedup();
+        let scene_keys = SCENE_RULES.iter().map(|r| r.key.to_string());
+        let layer_keys = LAYER_RULES.iter().map(|r| format!("layers.{}", r.key));
+        let volume_keys = VOLUME_RULES.iter().map(|r| format!("volumes.{}", r.key));
+        let mut ruled: Vec<String> = scene_keys.chain(layer_keys).chain(volume_keys).collect();
+        ruled.sort();
+        assert_eq!(ruled, fields);
+    }
+
+    #[test]
+    fn defaults_and_the_fully_populated_scene_are_valid() {
+        validate(&Scene::default()).unwrap();
+        validate(&fully_populated()).unwrap();
+    }
+
+    #[test]
+    fn bounds_are_compared_in_f32_so_the_documented_limits_are_allowed() {
+        let mut scene = Scene::default();
+        scene.phase.g = 0.99;
+        scene.phase.g_back = -0.99;
+        scene.weather.extent_km = 0.1;
+        scene.sky.gradient_exponent = 0.05;
+        validate(&scene).unwrap();
+    }
+
+    #[test]
+    fn violations_name_the_element_value_and_range() {
+        let mut scene = Scene::default();
+        scene.sun.color[1] = 1.5;
+        let violation = validate(&scene).unwrap_err();
+        assert_eq!(violation.key, "sun.color.1");
+        assert_eq!(violation.message, "1.5 is out of range; allowed 0..1");
+
+        let mut scene = Scene::default();
+        scene.camera.fov_y_deg = f32::NAN;
+        let violation = validate(&scene).unwrap_err();
+        assert_eq!(
+            violation.message,
+            "NaN is not a finite number; allowed 1..179 deg"
+        );
+    }
+
+    #[test]
+    fn relations_between_fields_are_checked() {
+        type Breaker = fn(&mut Scene);
+        let cases: [(Breaker, &str); 6] = [
+            (|s| s.camera.far_m = s.camera.near_m, "camera.far_m"),
+            (
+                |s| s.camera.look_at_m = Some(s.camera.position_m),
+                "camera.look_at_m",
+            ),
+            (|s| s.weather.source = WeatherSource::File, "weather.source"),
+            (|s| s.render.output = "frame.jpg".into(), "render.output"),
+            (|s| s.layers[0].types.cumulus = 0.0, "layers.0.types"),
+            (|s| s.volumes.push(VolumeGrid::default()), "volumes.0.path"),
+        ];
+        for (break_it, key) in cases {
+            let mut scene = Scene::default();
+            break_it(&mut scene);
+            assert_eq!(validate(&scene).unwrap_err().key, key);
+        }
+    }
+}
