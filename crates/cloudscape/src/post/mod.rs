@@ -1,1 +1,3 @@
-//! post (in progress)
+//! Post-processing of HDR frames: exposure, tone mapping and display encoding.
+
+pub mod tonemap;
