@@ -1,1 +1,183 @@
-//! image (in progress)
+//! Images: linear HDR frames and sRGB display frames, their files (OpenEXR, PNG) and their
+//! comparison (FLIP, relative MSE).
+//!
+//! Pixels are stored row by row from the top-left corner.
+
+mod compare;
+mod io;
+
+pub use compare::{FlipStats, flip, relative_mse};
+pub use io::write_image;
+
+use std::path::PathBuf;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use crate::post::tonemap::{display_rgb8, quantize_u8};
+use crate::scene::Tonemap;
+
+/// A linear HDR image: radiance RGB (scene radiometric units) and alpha (coverage, 0..1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HdrImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width * height` pixels, `[r, g, b, a]`, row by row from the top left.
+    pub pixels: Vec<[f32; 4]>,
+}
+
+/// A display image: sRGB-encoded 8-bit RGB and linear 8-bit alpha.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LdrImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width * height` pixels, `[r, g, b, a]`, row by row from the top left.
+    pub pixels: Vec<[u8; 4]>,
+}
+
+/// What went wrong reading, writing or comparing images; file errors name the file.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageError {
+    /// The file name ends in neither `.png` nor `.exr`.
+    #[error("{}: unsupported image file type (use a .png or .exr file name)", path.display())]
+    UnsupportedFormat {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The operating system refused to create, write, rename or read the file.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// The PNG encoder or decoder failed.
+    #[error("{}: PNG: {source}", path.display())]
+    Png {
+        /// The file.
+        path: PathBuf,
+        /// The `image` crate's error.
+        source: ::image::ImageError,
+    },
+    /// The OpenEXR encoder or decoder failed.
+    #[error("{}: OpenEXR: {source}", path.display())]
+    Exr {
+        /// The file.
+        path: PathBuf,
+        /// The `exr` crate's error.
+        source: exr::error::Error,
+    },
+    /// The pixel buffer does not hold `width * height` pixels, or the image is empty.
+    #[error("image of {width}x{height} pixels holds {len} pixels (expected width * height > 0)")]
+    BadSize {
+        /// Declared width.
+        width: u32,
+        /// Declared height.
+        height: u32,
+        /// Pixels in the buffer.
+        len: usize,
+    },
+    /// Two compared images differ in size.
+    #[error("image sizes differ: reference {reference:?}, test {test:?} (width, height)")]
+    SizeMismatch {
+        /// Reference `(width, height)`.
+        reference: (u32, u32),
+        /// Test `(width, height)`.
+        test: (u32, u32),
+    },
+}
+
+/// Checks that a `width x height` image with `len` pixels is non-empty and consistent.
+fn check_size(width: u32, height: u32, len: usize) -> Result<(), ImageError> {
+    let expected = width as usize * height as usize;
+    if expected == 0 || len != expected {
+        return Err(ImageError::BadSize { width, height, len });
+    }
+    Ok(())
+}
+
+/// Rec. 709 luminance weights of linear sRGB (ITU-R BT.709).
+const LUMINANCE_WEIGHTS: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
+impl HdrImage {
+    /// A black, transparent image.
+    pub fn new(width: u32, height: u32) -> Self {
+        HdrImage {
+            width,
+            height,
+            pixels: vec![[0.0; 4]; width as usize * height as usize],
+        }
+    }
+
+    /// The display image: exposure by `exposure_ev` stops, tone mapping by `op`, sRGB encoding;
+    /// alpha is quantised linearly.
+    pub fn to_ldr(&self, exposure_ev: f32, op: Tonemap) -> LdrImage {
+        let pixels = self
+            .pixels
+            .par_iter()
+            .map(|&[r, g, b, a]| {
+                let [r8, g8, b8] = display_rgb8(Vec3::new(r, g, b), exposure_ev, op);
+                [r8, g8, b8, quantize_u8(a)]
+            })
+            .collect();
+        LdrImage {
+            width: self.width,
+            height: self.height,
+            pixels,
+        }
+    }
+
+    /// Mean Rec. 709 luminance of the radiance over all pixels (0 for an empty image).
+    pub fn mean_luminance(&self) -> f64 {
+        if self.pixels.is_empty() {
+            return 0.0;
+        }
+        let total: f64 = self
+            .pixels
+            .iter()
+            .map(|p| {
+                (0..3)
+                    .map(|c| LUMINANCE_WEIGHTS[c] * f64::from(p[c]))
+                    .sum::<f64>()
+            })
+            .sum();
+        total / self.pixels.len() as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn to_ldr_tonemaps_every_pixel() {
+        let mut hdr = HdrImage::new(2, 1);
+        hdr.pixels[1] = [1e6, 1e6, 1e6, 0.5];
+        let ldr = hdr.to_ldr(0.0, Tonemap::Aces);
+        assert_eq!((ldr.width, ldr.height), (2, 1));
+        assert_eq!(ldr.pixels, vec![[0, 0, 0, 0], [255, 255, 255, 128]]);
+    }
+
+    #[test]
+    fn mean_luminance_weights_green_most() {
+        let mut hdr = HdrImage::new(2, 1);
+        hdr.pixels = vec![[1.0, 1.0, 1.0, 1.0], [0.0, 1.0, 0.0, 1.0]];
+        assert!((hdr.mean_luminance() - (1.0 + 0.7152) / 2.0).abs() < 1e-12);
+        assert_eq!(HdrImage::new(0, 0).mean_luminance(), 0.0);
+    }
+
+    #[test]
+    fn size_check_rejects_inconsistent_buffers() {
+        assert!(check_size(2, 2, 4).is_ok());
+        assert!(matches!(
+            check_size(2, 2, 3),
+            Err(ImageError::BadSize { len: 3, .. })
+        ));
+        assert!(check_size(0, 5, 0).is_err());
+    }
+}
