@@ -292,12 +292,15 @@ mod tests {
         VoxelGrid::from_fn([6, 5, 4], min, max, |p| (p.y - 1500.0) / 2000.0)
     }
 
-    fn export(name: &str, scene: &Scene) -> (PathBuf, String) {
+    /// Exports `scene` to a temporary directory and returns the grid read back and the XML.
+    fn export(name: &str, scene: &Scene) -> (VoxelGrid, String) {
         let dir =
             std::env::temp_dir().join(format!("cloudscape-mitsuba-{name}-{}", std::process::id()));
         let path = write_mitsuba_scene(&dir, scene, &test_grid(), 0.06).unwrap();
         let xml = std::fs::read_to_string(&path).unwrap();
-        (dir, xml)
+        let grid = VoxelGrid::read_vol(&dir.join(GRID_FILE_NAME)).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        (grid, xml)
     }
 
     /// The three numbers of the first attribute value that follows `marker`.
@@ -316,7 +319,7 @@ mod tests {
 
     #[test]
     fn scene_has_every_part_with_the_scene_numbers() {
-        let (dir, xml) = export("parts", &Scene::default());
+        let (grid, xml) = export("parts", &Scene::default());
         for expected in [
             "<scene version=\"3.0.0\">",
             "<integrator type=\"volpath\">",
@@ -344,10 +347,7 @@ mod tests {
             assert!(xml.contains(expected), "{expected} missing from\n{xml}");
         }
         assert_eq!(xml.matches("<phase type=\"hg\"").count(), 2);
-        assert_eq!(
-            VoxelGrid::read_vol(&dir.join(GRID_FILE_NAME)).unwrap(),
-            test_grid()
-        );
+        assert_eq!(grid, test_grid());
     }
 
     #[test]

@@ -359,6 +359,7 @@ mod tests {
         grid.write_vol(&path).unwrap();
         assert_eq!(std::fs::metadata(&path).unwrap().len(), 48 + 4 * 24);
         assert_eq!(VoxelGrid::read_vol(&path).unwrap(), grid);
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     }
 
     #[test]
@@ -433,6 +434,7 @@ mod tests {
             }
         ));
         assert!(error.to_string().contains("short.vol"));
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     }
 
     #[test]
@@ -474,5 +476,6 @@ mod tests {
             })
         ));
         assert!(!path.exists());
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     }
 }
