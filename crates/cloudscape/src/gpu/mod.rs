@@ -1,1 +1,13 @@
-//! gpu (in progress)
+//! GPU set-up and utilities shared by every technique.
+//!
+//! - [`context`]: adapter choice and device creation, the only place that knows wgpu's set-up API.
+//! - [`readback`]: copying textures and buffers back to the CPU.
+//! - [`timing`]: per-pass GPU time from timestamp queries.
+
+pub mod context;
+pub mod readback;
+pub mod timing;
+
+pub use context::{Backend, GpuContext, GpuError, GpuOptions};
+pub use readback::{read_buffer, read_texture, read_texture_rgba16f, read_texture_rgba32f};
+pub use timing::PassTimer;

@@ -1,0 +1,334 @@
+//! Adapter and device set-up: the only code in the crate that knows wgpu's set-up API.
+//!
+//! [`GpuContext::new`] enumerates every adapter of the allowed backends, filters them by name, ranks
+//! them (discrete > integrated > virtual > CPU > other, then Vulkan / Metal / DX12 over GL) and opens
+//! a device with the adapter's own limits and, when available, timestamp queries.
+
+use std::fmt;
+use std::str::FromStr;
+use std::sync::OnceLock;
+
+/// What to install when no adapter exists; part of every [`GpuError::NoAdapter`] message.
+const INSTALL_HINT: &str = "On Debian/Ubuntu: apt-get install mesa-vulkan-drivers libvulkan1 \
+     (software Vulkan) or a GPU driver; or pass --backend gl to use OpenGL (llvmpipe via EGL)";
+
+/// Environment variable that picks the backend of [`GpuContext::for_tests`] (`vulkan` or `gl`).
+pub const TEST_BACKEND_ENV: &str = "CLOUDSCAPE_TEST_BACKEND";
+
+/// A graphics API that wgpu can run on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backend {
+    /// Vulkan (Linux, Windows, Android; Mesa lavapipe in software).
+    Vulkan,
+    /// OpenGL ES / desktop GL through EGL (Mesa llvmpipe in software).
+    Gl,
+    /// Metal (macOS, iOS).
+    Metal,
+    /// Direct3D 12 (Windows).
+    Dx12,
+}
+
+impl Backend {
+    /// Every backend, in the order used when listing them.
+    pub const ALL: [Backend; 4] = [Backend::Vulkan, Backend::Gl, Backend::Metal, Backend::Dx12];
+
+    /// The name used on the command line and in [`fmt::Display`].
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Vulkan => "vulkan",
+            Backend::Gl => "gl",
+            Backend::Metal => "metal",
+            Backend::Dx12 => "dx12",
+        }
+    }
+
+    fn to_wgpu(self) -> wgpu::Backends {
+        match self {
+            Backend::Vulkan => wgpu::Backends::VULKAN,
+            Backend::Gl => wgpu::Backends::GL,
+            Backend::Metal => wgpu::Backends::METAL,
+            Backend::Dx12 => wgpu::Backends::DX12,
+        }
+    }
+}
+
+impl fmt::Display for Backend {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Backend {
+    type Err = GpuError;
+
+    /// Parses `vulkan`, `gl`, `metal` or `dx12` (case-insensitive).
+    fn from_str(text: &str) -> Result<Backend, GpuError> {
+        Backend::ALL
+            .into_iter()
+            .find(|backend| backend.name().eq_ignore_ascii_case(text.trim()))
+            .ok_or_else(|| GpuError::UnknownBackend {
+                name: text.to_string(),
+            })
+    }
+}
+
+/// How to choose the adapter.
+#[derive(Clone, Debug, Default)]
+pub struct GpuOptions {
+    /// Only this backend; `None` allows Vulkan, GL, Metal and DX12.
+    pub backend: Option<Backend>,
+    /// Only adapters whose name contains this text (case-insensitive).
+    pub adapter_substring: Option<String>,
+}
+
+/// Why no GPU context could be made.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// A backend name that is not one of ours.
+    #[error("unknown GPU backend {name:?}: expected one of vulkan, gl, metal, dx12")]
+    UnknownBackend {
+        /// The text that was given.
+        name: String,
+    },
+    /// No adapter passed the filters.
+    #[error("no usable GPU adapter: {seen}.\n{INSTALL_HINT}")]
+    NoAdapter {
+        /// The adapters that were seen and why each was rejected, or that none was seen.
+        seen: String,
+    },
+    /// The chosen adapter refused to open a device.
+    #[error("the GPU adapter {adapter} could not open a device: {source}")]
+    RequestDevice {
+        /// [`GpuContext::summary`]-style description of the adapter.
+        adapter: String,
+        /// wgpu's reason.
+        #[source]
+        source: wgpu::RequestDeviceError,
+    },
+}
+
+/// An open device and its queue, with what was learnt about the adapter.
+///
+/// Cloning is cheap: wgpu handles are reference counted, and clones share one device.
+#[derive(Clone, Debug)]
+pub struct GpuContext {
+    /// The logical device.
+    pub device: wgpu::Device,
+    /// Its only queue.
+    pub queue: wgpu::Queue,
+    adapter: wgpu::Adapter,
+    info: wgpu::AdapterInfo,
+}
+
+impl GpuContext {
+    /// Picks an adapter as described in the module documentation and opens a device on it.
+    /// Blocks until the device is ready.
+    pub fn new(options: &GpuOptions) -> Result<GpuContext, GpuError> {
+        pollster::block_on(Self::new_async(options))
+    }
+
+    async fn new_async(options: &GpuOptions) -> Result<GpuContext, GpuError> {
+        let backends = options.backend.map_or(all_backends(), Backend::to_wgpu);
+        let mut instance_descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
+        instance_descriptor.backends = backends;
+        instance_descriptor.flags = instance_descriptor.flags.with_env();
+        let instance = wgpu::Instance::new(instance_descriptor);
+        let adapters = instance.enumerate_adapters(backends).await;
+        let adapter = choose_adapter(adapters, options)?;
+        let info = adapter.get_info();
+        let (device, queue) = adapter
+            .request_device(&device_descriptor(&adapter))
+            .await
+            .map_err(|source| GpuError::RequestDevice {
+                adapter: describe(&info),
+                source,
+            })?;
+        Ok(GpuContext {
+            device,
+            queue,
+            adapter,
+            info,
+        })
+    }
+
+    /// The chosen adapter's name, backend, type and driver.
+    pub fn adapter_info(&self) -> &wgpu::AdapterInfo {
+        &self.info
+    }
+
+    /// One line naming the adapter, e.g. `llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu)`.
+    pub fn summary(&self) -> String {
+        describe(&self.info)
+    }
+
+    /// Whether passes can write timestamps ([`wgpu::Features::TIMESTAMP_QUERY`] was granted).
+    pub fn has_timestamps(&self) -> bool {
+        self.device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+    }
+
+    /// Largest width or height of a 2D texture on this device, in texels.
+    pub fn max_texture_dimension_2d(&self) -> u32 {
+        self.device.limits().max_texture_dimension_2d
+    }
+
+    /// The features the adapter offers, whether or not the device requested them.
+    pub fn adapter_features(&self) -> wgpu::Features {
+        self.adapter.features()
+    }
+
+    /// The shared context of GPU tests.
+    ///
+    /// Honours the environment variable [`TEST_BACKEND_ENV`] (`vulkan` or `gl`); without it any
+    /// backend is allowed. All callers in one process share one device, and the adapter used is
+    /// printed once to stderr.
+    ///
+    /// # Panics
+    /// When the variable holds an unknown backend or no adapter exists: GPU tests never skip silently.
+    pub fn for_tests() -> GpuContext {
+        static SHARED: OnceLock<GpuContext> = OnceLock::new();
+        SHARED
+            .get_or_init(|| {
+                let context = Self::new(&test_options()).unwrap_or_else(|error| panic!("{error}"));
+                eprintln!("cloudscape GPU tests run on {}", context.summary());
+                context
+            })
+            .clone()
+    }
+}
+
+fn all_backends() -> wgpu::Backends {
+    Backend::ALL
+        .into_iter()
+        .fold(wgpu::Backends::empty(), |all, backend| {
+            all | backend.to_wgpu()
+        })
+}
+
+fn test_options() -> GpuOptions {
+    let backend = std::env::var(TEST_BACKEND_ENV)
+        .ok()
+        .filter(|text| !text.trim().is_empty());
+    let backend = backend.map(|text| {
+        text.parse::<Backend>()
+            .unwrap_or_else(|error| panic!("{TEST_BACKEND_ENV}: {error}"))
+    });
+    GpuOptions {
+        backend,
+        adapter_substring: None,
+    }
+}
+
+fn describe(info: &wgpu::AdapterInfo) -> String {
+    format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
+}
+
+/// Keeps the adapters whose name matches, then takes the best by [`rank`]; the first wins a tie.
+fn choose_adapter(
+    adapters: Vec<wgpu::Adapter>,
+    options: &GpuOptions,
+) -> Result<wgpu::Adapter, GpuError> {
+    let wanted = options.adapter_substring.as_deref().map(str::to_lowercase);
+    let (matching, rejected): (Vec<_>, Vec<_>) = adapters.into_iter().partition(|adapter| {
+        wanted
+            .as_deref()
+            .is_none_or(|text| adapter.get_info().name.to_lowercase().contains(text))
+    });
+    let key = |adapter: &wgpu::Adapter| {
+        let info = adapter.get_info();
+        rank(info.device_type, info.backend)
+    };
+    matching
+        .into_iter()
+        .min_by_key(key)
+        .ok_or_else(|| GpuError::NoAdapter {
+            seen: rejection_report(&rejected, options),
+        })
+}
+
+/// Sort key of an adapter: device type first, then native APIs before GL. Lower is better.
+fn rank(device_type: wgpu::DeviceType, backend: wgpu::Backend) -> (u8, u8) {
+    let type_rank = match device_type {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Cpu => 3,
+        wgpu::DeviceType::Other => 4,
+    };
+    (type_rank, u8::from(backend == wgpu::Backend::Gl))
+}
+
+fn rejection_report(rejected: &[wgpu::Adapter], options: &GpuOptions) -> String {
+    let backends = options
+        .backend
+        .map_or("vulkan, gl, metal or dx12".to_string(), |b| b.to_string());
+    if rejected.is_empty() {
+        return format!("no adapter found on backend {backends}");
+    }
+    let wanted = options.adapter_substring.as_deref().unwrap_or_default();
+    let lines: Vec<String> = rejected
+        .iter()
+        .map(|adapter| {
+            format!(
+                "{} rejected: name does not contain {wanted:?}",
+                describe(&adapter.get_info())
+            )
+        })
+        .collect();
+    format!("adapters seen on backend {backends}: {}", lines.join("; "))
+}
+
+/// Timestamp features when offered, and the adapter's own limits so that large textures work.
+fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
+    let timing = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+    wgpu::DeviceDescriptor {
+        label: Some("cloudscape device"),
+        required_features: adapter.features() & timing,
+        required_limits: adapter.limits(),
+        ..Default::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn backend_names_round_trip() {
+        for backend in Backend::ALL {
+            assert_eq!(backend.to_string().parse::<Backend>().unwrap(), backend);
+        }
+        assert_eq!("Vulkan".parse::<Backend>().unwrap(), Backend::Vulkan);
+    }
+
+    #[test]
+    fn unknown_backend_lists_the_choices() {
+        let message = "opengl".parse::<Backend>().unwrap_err().to_string();
+        assert!(message.contains("\"opengl\"") && message.contains("vulkan, gl, metal, dx12"));
+    }
+
+    #[test]
+    fn discrete_beats_cpu_and_vulkan_beats_gl() {
+        let discrete_gl = rank(wgpu::DeviceType::DiscreteGpu, wgpu::Backend::Gl);
+        let cpu_vulkan = rank(wgpu::DeviceType::Cpu, wgpu::Backend::Vulkan);
+        let cpu_gl = rank(wgpu::DeviceType::Cpu, wgpu::Backend::Gl);
+        let other_vulkan = rank(wgpu::DeviceType::Other, wgpu::Backend::Vulkan);
+        assert!(discrete_gl < cpu_vulkan && cpu_vulkan < cpu_gl && cpu_gl < other_vulkan);
+    }
+
+    #[test]
+    fn no_adapter_message_says_what_to_install() {
+        let options = GpuOptions {
+            backend: Some(Backend::Metal),
+            adapter_substring: None,
+        };
+        let message = GpuError::NoAdapter {
+            seen: rejection_report(&[], &options),
+        }
+        .to_string();
+        assert!(message.contains("no adapter found on backend metal"));
+        assert!(message.contains("apt-get install mesa-vulkan-drivers libvulkan1"));
+        assert!(message.contains("--backend gl"));
+    }
+}
