@@ -1,1 +1,43 @@
-fn main() {}
+//! `cloudscape`: render, export and benchmark cloud scenes from the command line.
+
+mod bench;
+mod common;
+mod export;
+mod render;
+
+use clap::{Parser, Subcommand};
+
+/// Physically based real-time clouds: render, export and benchmark scenes.
+#[derive(Parser)]
+#[command(name = "cloudscape", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene (the embedded default when no file is given) to a PNG or EXR image.
+    Render(render::RenderArgs),
+    /// Write a scene's cloud field as a Mitsuba 3 `.vol` grid plus a Mitsuba scene with the same
+    /// camera, sun, sky and phase function.
+    Export(export::ExportArgs),
+    /// Time the GPU passes of a scene over many frames.
+    Bench(bench::BenchArgs),
+}
+
+fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(args) => render::run(args),
+        Command::Export(args) => export::run(args),
+        Command::Bench(args) => bench::run(args),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}

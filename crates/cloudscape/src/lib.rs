@@ -11,4 +11,5 @@ pub mod image;
 pub mod optics;
 pub mod post;
 pub mod raymarch;
+pub mod renderer;
 pub mod scene;

@@ -125,7 +125,7 @@ fn field_apply_coverage(shape: f32, coverage: f32, type_coord: f32, f: f32) -> f
     if c <= 0.0 {
         return 0.0;
     }
-    return field_remap(shape, 1.0 - c, 1.0, 0.0, 1.0) * c;
+    return field_remap(shape, 1.0 - c, 1.0, 0.0, 1.0);
 }
 
 fn field_erode(density: f32, detail: vec4<f32>, f: f32, erosion: f32) -> f32 {

@@ -2,7 +2,9 @@
 //! atlas uploaded, and the uniform that `field.wgsl` reads, all in one bind group (group 0).
 
 use super::{CloudField, MAX_LAYERS, MAX_VOLUMES, NoiseKind};
-use crate::gpu::pipeline::{UNIFORM, bind_group, bind_group_layout, compute_pipeline, float_texture};
+use crate::gpu::pipeline::{
+    UNIFORM, bind_group, bind_group_layout, compute_pipeline, float_texture,
+};
 use crate::gpu::{GpuContext, readback};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
@@ -64,14 +66,22 @@ impl FieldUniform {
         let flat = matches!(field.planet.shape, crate::scene::PlanetShape::Flat) as u32 as f32;
         u.planet = Vec4::new(field.planet.radius_m, flat, bottom, top);
         let n = &field.noise;
-        u.noise = Vec4::new(n.base_period_m, n.detail_period_m, n.detail_erosion, n.curl_displacement_m);
+        u.noise = Vec4::new(
+            n.base_period_m,
+            n.detail_period_m,
+            n.detail_erosion,
+            n.curl_displacement_m,
+        );
         u.weather = field.weather.extent_m.extend(time_s).extend(0.0);
         u.counts = [field.layers.len() as u32, field.volumes.len() as u32, 0, 0];
         u.atlas_size = atlas.size.extend(0.0);
         for (dst, l) in u.layers.iter_mut().zip(&field.layers) {
             *dst = LayerUniform {
                 shape: Vec4::new(l.bottom_m, l.thickness_m, l.coverage, l.extinction_per_m),
-                motion: l.wind_m_per_s.extend(l.weather_offset.x).extend(l.weather_offset.y),
+                motion: l
+                    .wind_m_per_s
+                    .extend(l.weather_offset.x)
+                    .extend(l.weather_offset.y),
                 noise_offset: l.noise_offset_m.extend(l.types.first),
                 type_bounds: Vec3::from_array(l.types.bounds).extend(2.0),
                 type_steps: Vec3::from_array(l.types.steps).extend(0.0),
@@ -82,7 +92,9 @@ impl FieldUniform {
                 min_m: v.min_m.extend(v.extinction_per_m),
                 size_m: v.size_m.extend(0.0),
                 atlas_origin: origin.extend(0.0),
-                resolution: glam::UVec3::from_array(v.grid.resolution).as_vec3().extend(0.0),
+                resolution: glam::UVec3::from_array(v.grid.resolution)
+                    .as_vec3()
+                    .extend(0.0),
             };
         }
         u
@@ -115,7 +127,11 @@ impl VolumeAtlas {
             origins.push(Vec3::new(0.0, 0.0, z0 as f32));
             z0 += gz;
         }
-        VolumeAtlas { size: Vec3::new(w as f32, h as f32, d as f32), origins, texels }
+        VolumeAtlas {
+            size: Vec3::new(w as f32, h as f32, d as f32),
+            origins,
+            texels,
+        }
     }
 }
 
@@ -137,13 +153,16 @@ impl FieldGpu {
         let weather = upload_rgba8(ctx, "weather map", &field.weather.texture);
         let atlas = VolumeAtlas::new(field);
         let atlas_texture = upload_atlas(ctx, &atlas);
-        let uniform = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("field uniform"),
-            contents: bytemuck::bytes_of(&FieldUniform::new(field, &atlas, 0.0)),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        });
+        let uniform = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("field uniform"),
+                contents: bytemuck::bytes_of(&FieldUniform::new(field, &atlas, 0.0)),
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            });
         let layout = field_layout(&ctx.device);
-        let views = [&base, &detail, &curl, &weather, &atlas_texture].map(|t| t.create_view(&Default::default()));
+        let views = [&base, &detail, &curl, &weather, &atlas_texture]
+            .map(|t| t.create_view(&Default::default()));
         let sampler = |mode| {
             ctx.device.create_sampler(&wgpu::SamplerDescriptor {
                 address_mode_u: mode,
@@ -154,17 +173,32 @@ impl FieldGpu {
                 ..Default::default()
             })
         };
-        let (repeat, clamp) = (sampler(wgpu::AddressMode::Repeat), sampler(wgpu::AddressMode::ClampToEdge));
+        let (repeat, clamp) = (
+            sampler(wgpu::AddressMode::Repeat),
+            sampler(wgpu::AddressMode::ClampToEdge),
+        );
         let mut resources = vec![uniform.as_entire_binding()];
         resources.extend(views.iter().map(wgpu::BindingResource::TextureView));
-        resources.extend([wgpu::BindingResource::Sampler(&repeat), wgpu::BindingResource::Sampler(&clamp)]);
+        resources.extend([
+            wgpu::BindingResource::Sampler(&repeat),
+            wgpu::BindingResource::Sampler(&clamp),
+        ]);
         let bind_group = bind_group(&ctx.device, &layout, &resources);
-        FieldGpu { uniform, atlas, layout, bind_group }
+        FieldGpu {
+            uniform,
+            atlas,
+            layout,
+            bind_group,
+        }
     }
 
     /// Moves the field to scene time `time_s` (wind) for the next submitted work.
     pub fn set_time(&self, ctx: &GpuContext, field: &CloudField, time_s: f32) {
-        ctx.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&FieldUniform::new(field, &self.atlas, time_s)));
+        ctx.queue.write_buffer(
+            &self.uniform,
+            0,
+            bytemuck::bytes_of(&FieldUniform::new(field, &self.atlas, time_s)),
+        );
     }
 
     /// The layout of bind group 0, for techniques' pipeline layouts.
@@ -198,8 +232,18 @@ impl FieldGpu {
             min_binding_size: None,
         };
         let layout = bind_group_layout(device, "probe", &[storage(true), storage(false)]);
-        let pipeline = compute_pipeline(ctx, "field probe", &probe_source(), "probe_field", &[&self.layout, &layout]);
-        let group = bind_group(device, &layout, &[input.as_entire_binding(), output.as_entire_binding()]);
+        let pipeline = compute_pipeline(
+            ctx,
+            "field probe",
+            &probe_source(),
+            "probe_field",
+            &[&self.layout, &layout],
+        );
+        let group = bind_group(
+            device,
+            &layout,
+            &[input.as_entire_binding(), output.as_entire_binding()],
+        );
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -216,14 +260,33 @@ impl FieldGpu {
 fn field_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     use wgpu::TextureViewDimension::{D2, D3};
     let sampler = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
-    let types = [UNIFORM, float_texture(D3), float_texture(D3), float_texture(D2), float_texture(D2), float_texture(D3), sampler, sampler];
+    let types = [
+        UNIFORM,
+        float_texture(D3),
+        float_texture(D3),
+        float_texture(D2),
+        float_texture(D2),
+        float_texture(D3),
+        sampler,
+        sampler,
+    ];
     bind_group_layout(device, "field", &types)
 }
 
-fn create_texture(ctx: &GpuContext, label: &str, dims: glam::UVec3, format: wgpu::TextureFormat, dimension: wgpu::TextureDimension) -> wgpu::Texture {
+fn create_texture(
+    ctx: &GpuContext,
+    label: &str,
+    dims: glam::UVec3,
+    format: wgpu::TextureFormat,
+    dimension: wgpu::TextureDimension,
+) -> wgpu::Texture {
     ctx.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
-        size: wgpu::Extent3d { width: dims.x, height: dims.y, depth_or_array_layers: dims.z },
+        size: wgpu::Extent3d {
+            width: dims.x,
+            height: dims.y,
+            depth_or_array_layers: dims.z,
+        },
         mip_level_count: 1,
         sample_count: 1,
         dimension,
@@ -234,24 +297,56 @@ fn create_texture(ctx: &GpuContext, label: &str, dims: glam::UVec3, format: wgpu
 }
 
 fn upload_rgba8(ctx: &GpuContext, label: &str, texture: &super::Texture8) -> wgpu::Texture {
-    let t = create_texture(ctx, label, texture.dims, wgpu::TextureFormat::Rgba8Unorm, wgpu::TextureDimension::D2);
+    let t = create_texture(
+        ctx,
+        label,
+        texture.dims,
+        wgpu::TextureFormat::Rgba8Unorm,
+        wgpu::TextureDimension::D2,
+    );
     write_texture(ctx, &t, texture.bytes(), 4 * texture.dims.x, texture.dims);
     t
 }
 
 fn upload_atlas(ctx: &GpuContext, atlas: &VolumeAtlas) -> wgpu::Texture {
     let dims = atlas.size.as_uvec3();
-    let t = create_texture(ctx, "volume atlas", dims, wgpu::TextureFormat::R16Float, wgpu::TextureDimension::D3);
-    write_texture(ctx, &t, bytemuck::cast_slice(&atlas.texels), 2 * dims.x, dims);
+    let t = create_texture(
+        ctx,
+        "volume atlas",
+        dims,
+        wgpu::TextureFormat::R16Float,
+        wgpu::TextureDimension::D3,
+    );
+    write_texture(
+        ctx,
+        &t,
+        bytemuck::cast_slice(&atlas.texels),
+        2 * dims.x,
+        dims,
+    );
     t
 }
 
-fn write_texture(ctx: &GpuContext, texture: &wgpu::Texture, bytes: &[u8], bytes_per_row: u32, dims: glam::UVec3) {
+fn write_texture(
+    ctx: &GpuContext,
+    texture: &wgpu::Texture,
+    bytes: &[u8],
+    bytes_per_row: u32,
+    dims: glam::UVec3,
+) {
     ctx.queue.write_texture(
         texture.as_image_copy(),
         bytes,
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(bytes_per_row), rows_per_image: Some(dims.y) },
-        wgpu::Extent3d { width: dims.x, height: dims.y, depth_or_array_layers: dims.z },
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(bytes_per_row),
+            rows_per_image: Some(dims.y),
+        },
+        wgpu::Extent3d {
+            width: dims.x,
+            height: dims.y,
+            depth_or_array_layers: dims.z,
+        },
     );
 }
 
@@ -272,7 +367,14 @@ fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture
     let device = &ctx.device;
     let dims = kind.dims();
     let row_pitch = (dims.x * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) / 4;
-    let params = NoiseGenParams { kind: kind.gpu_index(), seed, size: dims.x, row_pitch_texels: row_pitch, depth: dims.z, _pad: [0; 3] };
+    let params = NoiseGenParams {
+        kind: kind.gpu_index(),
+        seed,
+        size: dims.x,
+        row_pitch_texels: row_pitch,
+        depth: dims.z,
+        _pad: [0; 3],
+    };
     let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("noise params"),
         contents: bytemuck::bytes_of(&params),
@@ -284,13 +386,37 @@ fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
-    let storage = wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only: false }, has_dynamic_offset: false, min_binding_size: None };
+    let storage = wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Storage { read_only: false },
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    };
     let layout = bind_group_layout(device, "noise generator", &[UNIFORM, storage]);
-    let pipeline = compute_pipeline(ctx, "noise generator", &noise_gen_source(), "generate_noise", &[&layout]);
-    let group = bind_group(device, &layout, &[uniform.as_entire_binding(), buffer.as_entire_binding()]);
+    let pipeline = compute_pipeline(
+        ctx,
+        "noise generator",
+        &noise_gen_source(),
+        "generate_noise",
+        &[&layout],
+    );
+    let group = bind_group(
+        device,
+        &layout,
+        &[uniform.as_entire_binding(), buffer.as_entire_binding()],
+    );
     let label = format!("{kind:?} noise");
-    let dimension = if kind == NoiseKind::Curl { wgpu::TextureDimension::D2 } else { wgpu::TextureDimension::D3 };
-    let texture = create_texture(ctx, &label, dims, wgpu::TextureFormat::Rgba8Unorm, dimension);
+    let dimension = if kind == NoiseKind::Curl {
+        wgpu::TextureDimension::D2
+    } else {
+        wgpu::TextureDimension::D3
+    };
+    let texture = create_texture(
+        ctx,
+        &label,
+        dims,
+        wgpu::TextureFormat::Rgba8Unorm,
+        dimension,
+    );
     let mut encoder = device.create_command_encoder(&Default::default());
     {
         let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -301,10 +427,18 @@ fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture
     encoder.copy_buffer_to_texture(
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row_pitch * 4), rows_per_image: Some(dims.y) },
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row_pitch * 4),
+                rows_per_image: Some(dims.y),
+            },
         },
         texture.as_image_copy(),
-        wgpu::Extent3d { width: dims.x, height: dims.y, depth_or_array_layers: dims.z },
+        wgpu::Extent3d {
+            width: dims.x,
+            height: dims.y,
+            depth_or_array_layers: dims.z,
+        },
     );
     ctx.queue.submit([encoder.finish()]);
     texture

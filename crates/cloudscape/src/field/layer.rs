@@ -14,7 +14,7 @@ pub struct LayerField {
     pub bottom_m: f32,
     /// Thickness, metres.
     pub thickness_m: f32,
-    /// Scene coverage 0..1.
+    /// Coverage threshold 0..1 (Schneider 2015's coverage) that gives the scene's cloud fraction.
     pub coverage: f32,
     /// Extinction of the densest cloud, m^-1.
     pub extinction_per_m: f32,
@@ -31,11 +31,12 @@ pub struct LayerField {
 impl LayerField {
     /// The layer of a scene entry; its offsets come from hashing `noise_seed`.
     pub fn new(layer: &CloudLayer) -> LayerField {
-        let unit = |k: u32| hash_to_unit(pcg_hash(layer.noise_seed.wrapping_mul(4).wrapping_add(k)));
+        let unit =
+            |k: u32| hash_to_unit(pcg_hash(layer.noise_seed.wrapping_mul(4).wrapping_add(k)));
         LayerField {
             bottom_m: layer.bottom_m,
             thickness_m: layer.thickness_m,
-            coverage: layer.coverage,
+            coverage: coverage_threshold(layer.coverage),
             extinction_per_m: layer.extinction_per_m,
             types: TypeTable::from_mix(&layer.types),
             wind_m_per_s: Vec2::from_array(layer.wind_m_per_s),
@@ -44,11 +45,42 @@ impl LayerField {
         }
     }
 
-    /// Local coverage from the weather map's coverage channel: the scene coverage shifts the map,
-    /// `saturate(map + 2 coverage - 1)`, so 0 clears the layer, 0.5 keeps the map and 1 fills it.
+    /// Local coverage from the weather map's coverage channel, shifted by the layer's threshold:
+    /// `saturate(map + 2 threshold - 1)`, so 0 clears the layer and 1 fills it.
     pub fn local_coverage(&self, map_coverage: f32) -> f32 {
         (map_coverage + 2.0 * self.coverage - 1.0).clamp(0.0, 1.0)
     }
+}
+
+/// Measured fraction of the sky covered (columns of optical depth above 1) against the coverage
+/// threshold, for cumulus with the default noise: pairs (fraction, threshold). Measured with
+/// `cargo test --release -p cloudscape --test coverage -- --ignored --nocapture`.
+const COVERAGE_CALIBRATION: [(f32, f32); 12] = [
+    (0.0, 0.0),
+    (0.13, 0.1),
+    (0.27, 0.15),
+    (0.41, 0.2),
+    (0.53, 0.25),
+    (0.63, 0.3),
+    (0.72, 0.35),
+    (0.81, 0.4),
+    (0.88, 0.45),
+    (0.93, 0.5),
+    (0.98, 0.6),
+    (1.0, 1.0),
+];
+
+/// The coverage threshold that covers `fraction` of the sky (piecewise linear in
+/// [`COVERAGE_CALIBRATION`]).
+pub fn coverage_threshold(fraction: f32) -> f32 {
+    let f = fraction.clamp(0.0, 1.0);
+    COVERAGE_CALIBRATION
+        .windows(2)
+        .find(|w| f <= w[1].0)
+        .map_or(1.0, |w| {
+            let t = (f - w[0].0) / (w[1].0 - w[0].0);
+            w[0].1 + t * (w[1].1 - w[0].1)
+        })
 }
 
 /// Low-frequency cloud shape from the base texel: the Perlin-Worley channel remapped by the Worley
@@ -59,7 +91,9 @@ pub fn base_shape(base: Vec4) -> f32 {
     remap(base.x, fbm - 1.0, 1.0, 0.0, 1.0)
 }
 
-/// Coverage applied to the shaped base, `remap(shape, 1 - c, 1, 0, 1) * c` (Schneider 2015), with the
+/// Coverage applied to the shaped base, `remap(shape, 1 - c, 1, 0, 1)` (Schneider 2015 also multiplies
+/// by `c`, thinning sparse clouds; we leave density to the weather map's density channel, so that a
+/// layer's `extinction_per_m` is the extinction of its cloud cores), with the
 /// cumulonimbus anvil bias that widens coverage near the top, `c^remap(f, 0.7, 0.8, 1, lerp(1, 0.5,
 /// anvil))` (Schneider 2017), `anvil` growing from type 2 (cumulus) to 3 (cumulonimbus).
 pub fn apply_coverage(shape: f32, coverage: f32, type_coord: f32, f: f32) -> f32 {
@@ -69,7 +103,7 @@ pub fn apply_coverage(shape: f32, coverage: f32, type_coord: f32, f: f32) -> f32
     if c <= 0.0 {
         return 0.0;
     }
-    remap(shape, 1.0 - c, 1.0, 0.0, 1.0) * c
+    remap(shape, 1.0 - c, 1.0, 0.0, 1.0)
 }
 
 /// Detail erosion (Schneider 2015): the detail fBm, inverted from wispy at the base to billowy
@@ -86,18 +120,41 @@ mod tests {
 
     #[test]
     fn coverage_zero_and_one_are_clear_and_full() {
-        let l = LayerField::new(&CloudLayer { coverage: 0.0, ..CloudLayer::default() });
+        let l = LayerField::new(&CloudLayer {
+            coverage: 0.0,
+            ..CloudLayer::default()
+        });
         assert_eq!(l.local_coverage(1.0), 0.0);
-        let l = LayerField::new(&CloudLayer { coverage: 1.0, ..CloudLayer::default() });
+        let l = LayerField::new(&CloudLayer {
+            coverage: 1.0,
+            ..CloudLayer::default()
+        });
         assert_eq!(l.local_coverage(0.0), 1.0);
         assert_eq!(apply_coverage(0.7, 0.0, 2.0, 0.5), 0.0);
         assert!((apply_coverage(0.7, 1.0, 2.0, 0.5) - 0.7).abs() < 1e-6);
+        assert!(
+            apply_coverage(0.7, 0.2, 2.0, 0.5) <= 0.0,
+            "below the coverage threshold"
+        );
+    }
+
+    #[test]
+    fn coverage_threshold_is_monotone_from_clear_to_full() {
+        assert_eq!(coverage_threshold(0.0), 0.0);
+        assert_eq!(coverage_threshold(1.0), 1.0);
+        let values: Vec<f32> = (0..=100)
+            .map(|i| coverage_threshold(i as f32 / 100.0))
+            .collect();
+        assert!(values.windows(2).all(|w| w[1] > w[0]), "{values:?}");
     }
 
     #[test]
     fn anvil_widens_only_cumulonimbus_tops() {
         let (shape, c) = (0.6, 0.5);
-        assert_eq!(apply_coverage(shape, c, 2.0, 0.9), apply_coverage(shape, c, 2.0, 0.5));
+        assert_eq!(
+            apply_coverage(shape, c, 2.0, 0.9),
+            apply_coverage(shape, c, 2.0, 0.5)
+        );
         assert!(apply_coverage(shape, c, 3.0, 0.9) > apply_coverage(shape, c, 3.0, 0.5));
     }
 

@@ -97,7 +97,11 @@ struct NoiseSource {
 
 impl NoiseSource {
     fn new(kind: NoiseKind, seed: u32) -> NoiseSource {
-        NoiseSource { kind, seed, baked: OnceLock::new() }
+        NoiseSource {
+            kind,
+            seed,
+            baked: OnceLock::new(),
+        }
     }
 
     fn sample(&self, uvw: Vec3) -> Vec4 {
@@ -135,30 +139,57 @@ pub struct CloudField {
 impl CloudField {
     /// Builds the field of `scene`; files (weather PNG, `.vol` grids) resolve against `base_dir`.
     pub fn new(scene: &Scene, base_dir: &Path) -> Result<CloudField, FieldError> {
-        let err = |key: &str, message: String| FieldError { key_path: key.to_string(), message };
+        let err = |key: &str, message: String| FieldError {
+            key_path: key.to_string(),
+            message,
+        };
         if scene.layers.len() > MAX_LAYERS {
-            return Err(err("layers", format!("{} layers given; at most {MAX_LAYERS} are supported", scene.layers.len())));
+            return Err(err(
+                "layers",
+                format!(
+                    "{} layers given; at most {MAX_LAYERS} are supported",
+                    scene.layers.len()
+                ),
+            ));
         }
         if scene.volumes.len() > MAX_VOLUMES {
-            return Err(err("volumes", format!("{} volumes given; at most {MAX_VOLUMES} are supported", scene.volumes.len())));
+            return Err(err(
+                "volumes",
+                format!(
+                    "{} volumes given; at most {MAX_VOLUMES} are supported",
+                    scene.volumes.len()
+                ),
+            ));
         }
         let resolve = |p: &str| -> PathBuf { base_dir.join(p) };
         let weather_file = scene.weather.path.as_deref().map(resolve);
-        let weather = Weather::from_scene(&scene.weather, weather_file.as_deref()).map_err(|m| err("weather.path", m))?;
+        let weather = Weather::from_scene(&scene.weather, weather_file.as_deref())
+            .map_err(|m| err("weather.path", m))?;
         let volumes = scene
             .volumes
             .iter()
             .enumerate()
             .map(|(i, v)| {
-                let mut grid = VoxelGrid::read_vol(&resolve(&v.path)).map_err(|e| err(&format!("volumes.{i}.path"), e.to_string()))?;
-                grid.values.iter_mut().for_each(|x| *x = half::f16::from_f32(*x).to_f32());
+                let mut grid = VoxelGrid::read_vol(&resolve(&v.path))
+                    .map_err(|e| err(&format!("volumes.{i}.path"), e.to_string()))?;
+                grid.values
+                    .iter_mut()
+                    .for_each(|x| *x = half::f16::from_f32(*x).to_f32());
                 let size_m = Vec3::from_array(v.size_m);
-                Ok(PlacedVolume { grid, min_m: Vec3::from_array(v.center_m) - size_m * 0.5, size_m, extinction_per_m: v.extinction_per_m })
+                Ok(PlacedVolume {
+                    grid,
+                    min_m: Vec3::from_array(v.center_m) - size_m * 0.5,
+                    size_m,
+                    extinction_per_m: v.extinction_per_m,
+                })
             })
             .collect::<Result<Vec<_>, FieldError>>()?;
         let seed = scene.noise.seed;
         Ok(CloudField {
-            planet: PlanetGeometry { shape: scene.planet.shape, radius_m: scene.planet.radius_m },
+            planet: PlanetGeometry {
+                shape: scene.planet.shape,
+                radius_m: scene.planet.radius_m,
+            },
             layers: scene.layers.iter().map(LayerField::new).collect(),
             weather,
             noise: scene.noise.clone(),
@@ -172,7 +203,10 @@ impl CloudField {
     /// Computes all noise texels now (a few seconds on all cores in a release build), making every
     /// later [`CloudField::extinction_per_m`] call cheap. For CPU renderers; the GPU needs none of it.
     pub fn bake_noise(&self) {
-        rayon::join(|| self.base.bake(), || rayon::join(|| self.detail.bake(), || self.curl.bake()));
+        rayon::join(
+            || self.base.bake(),
+            || rayon::join(|| self.detail.bake(), || self.curl.bake()),
+        );
     }
 
     /// Seed of the noise textures (the GPU generates them from it).
@@ -184,14 +218,27 @@ impl CloudField {
     /// the sum over layers and voxel grids.
     pub fn extinction_per_m(&self, p: Vec3, time_s: f32) -> f32 {
         let h = self.planet.altitude_m(p);
-        let layers: f32 = self.layers.iter().map(|l| self.layer_extinction(l, p, h, time_s)).sum();
-        layers + self.volumes.iter().map(|v| v.extinction_per_m(p)).sum::<f32>()
+        let layers: f32 = self
+            .layers
+            .iter()
+            .map(|l| self.layer_extinction(l, p, h, time_s))
+            .sum();
+        layers
+            + self
+                .volumes
+                .iter()
+                .map(|v| v.extinction_per_m(p))
+                .sum::<f32>()
     }
 
     /// Lowest layer bottom and highest layer top, metres (None without layers).
     pub fn altitude_range_m(&self) -> Option<(f32, f32)> {
         let bottom = self.layers.iter().map(|l| l.bottom_m).reduce(f32::min)?;
-        let top = self.layers.iter().map(|l| l.bottom_m + l.thickness_m).reduce(f32::max)?;
+        let top = self
+            .layers
+            .iter()
+            .map(|l| l.bottom_m + l.thickness_m)
+            .reduce(f32::max)?;
         Some((bottom, top))
     }
 
@@ -203,7 +250,10 @@ impl CloudField {
         }
         let wind = layer.wind_m_per_s * time_s;
         let xz = Vec2::new(p.x, p.z) - wind;
-        let w = self.weather.texture.sample((xz / self.weather.extent_m + layer.weather_offset).extend(0.0));
+        let w = self
+            .weather
+            .texture
+            .sample((xz / self.weather.extent_m + layer.weather_offset).extend(0.0));
         let coverage = layer.local_coverage(w.x);
         if coverage <= 0.0 {
             return 0.0;
@@ -220,11 +270,15 @@ impl CloudField {
         if covered <= 0.0 {
             return 0.0;
         }
-        let curl = self.curl.sample(Vec3::new(q.x, q.z, 0.0) / self.noise.base_period_m);
-        let swirl = (Vec2::new(curl.x, curl.y) * 2.0 - 1.0) * self.noise.curl_displacement_m * (1.0 - f);
-        let detail = self.detail.sample((q + Vec3::new(swirl.x, 0.0, swirl.y)) / self.noise.detail_period_m);
+        let curl = self
+            .curl
+            .sample(Vec3::new(q.x, q.z, 0.0) / self.noise.base_period_m);
+        let swirl =
+            (Vec2::new(curl.x, curl.y) * 2.0 - 1.0) * self.noise.curl_displacement_m * (1.0 - f);
+        let detail = self
+            .detail
+            .sample((q + Vec3::new(swirl.x, 0.0, swirl.y)) / self.noise.detail_period_m);
         let density = layer::erode(covered, detail, f, self.noise.detail_erosion);
         density * w.z * layer.extinction_per_m
     }
 }
-

@@ -46,7 +46,11 @@ impl NoiseKind {
     /// The 8-bit RGBA texel at integer coordinates (wrapped into the tile).
     pub fn texel(self, seed: u32, texel: IVec3) -> [u8; 4] {
         let n = self.size() as i32;
-        let t = IVec3::new(texel.x.rem_euclid(n), texel.y.rem_euclid(n), texel.z.rem_euclid(n));
+        let t = IVec3::new(
+            texel.x.rem_euclid(n),
+            texel.y.rem_euclid(n),
+            texel.z.rem_euclid(n),
+        );
         let value = match self {
             NoiseKind::Base => base_texel(seed, t),
             NoiseKind::Detail => detail_texel(seed, t),
@@ -81,7 +85,11 @@ pub fn hash_to_unit(h: u32) -> f32 {
 }
 
 fn wrap(cell: IVec3, period: i32) -> IVec3 {
-    IVec3::new(cell.x.rem_euclid(period), cell.y.rem_euclid(period), cell.z.rem_euclid(period))
+    IVec3::new(
+        cell.x.rem_euclid(period),
+        cell.y.rem_euclid(period),
+        cell.z.rem_euclid(period),
+    )
 }
 
 /// Quintic fade 6t^5 - 15t^4 + 10t^3 (Perlin 2002, "Improving Noise").
@@ -158,14 +166,21 @@ pub fn worley_fbm(uvw: Vec3, cells: i32, seed: u32) -> f32 {
         + 0.125 * worley(uvw * (4 * cells) as f32, 4 * cells, seed ^ 0xa3)
 }
 
-/// Three Perlin octaves at `cells`, `2 cells`, `4 cells` per tile, amplitudes 1, 1/2, 1/4,
-/// normalised and mapped to 0..1.
+/// Three Perlin octaves at `cells`, `2 cells`, `4 cells` per tile, amplitudes 1, 1/2, 1/4, mapped
+/// to 0..1 as `0.5 + PERLIN_CONTRAST * sum`, clamped. Perlin noise has a standard deviation of
+/// only about 0.2, so the contrast spreads the fBm over the whole range, where coverage can carve it.
 pub fn perlin_fbm01(uvw: Vec3, cells: i32, seed: u32) -> f32 {
     let sum = perlin(uvw * cells as f32, cells, seed)
         + 0.5 * perlin(uvw * (2 * cells) as f32, 2 * cells, seed ^ 0x51)
         + 0.25 * perlin(uvw * (4 * cells) as f32, 4 * cells, seed ^ 0xa3);
-    (sum / 1.75 * 0.5 + 0.5).clamp(0.0, 1.0)
+    (0.5 + PERLIN_CONTRAST * sum).clamp(0.0, 1.0)
 }
+
+/// Gain from the Perlin fBm sum to its 0..1 encoding (chosen so that about 5 % of values clamp).
+pub const PERLIN_CONTRAST: f32 = 1.2;
+
+/// Gain from the curl potential's central differences to the encoded velocity.
+const CURL_GAIN: f32 = 2.0;
 
 /// `value` mapped from [lo0, hi0] to [lo1, hi1] (Schneider 2015's `Remap`).
 pub fn remap(value: f32, lo0: f32, hi0: f32, lo1: f32, hi1: f32) -> f32 {
@@ -211,7 +226,7 @@ fn curl_texel(seed: u32, texel: IVec3) -> Vec4 {
         let uv = texel_centre(texel + IVec3::new(dx, dy, 0), n);
         perlin_fbm01(Vec3::new(uv.x, uv.y, 0.0), 4, seed ^ 0x8000)
     };
-    let scale = n as f32 / 16.0;
+    let scale = CURL_GAIN;
     let vx = (psi(0, 1) - psi(0, -1)) * scale;
     let vy = -(psi(1, 0) - psi(-1, 0)) * scale;
     Vec4::new(0.5 + 0.5 * vx, 0.5 + 0.5 * vy, 0.5, 1.0)
@@ -245,8 +260,16 @@ mod tests {
         for kind in [NoiseKind::Base, NoiseKind::Detail, NoiseKind::Curl] {
             let n = kind.size() as i32;
             for t in [IVec3::new(0, 3, 0), IVec3::new(5, 0, 0)] {
-                let t = if kind == NoiseKind::Curl { t.with_z(0) } else { t };
-                assert_eq!(kind.texel(7, t), kind.texel(7, t + IVec3::new(n, -n, 0)), "{kind:?}");
+                let t = if kind == NoiseKind::Curl {
+                    t.with_z(0)
+                } else {
+                    t
+                };
+                assert_eq!(
+                    kind.texel(7, t),
+                    kind.texel(7, t + IVec3::new(n, -n, 0)),
+                    "{kind:?}"
+                );
             }
         }
         // Worley and Perlin are continuous across the tile seam.
@@ -263,7 +286,11 @@ mod tests {
         let mut sum_sq = 0.0;
         let n = 4000;
         for i in 0..n {
-            let p = Vec3::new(hash_to_unit(pcg_hash(i)), hash_to_unit(pcg_hash(i + 77_777)), 0.37) * 8.0;
+            let p = Vec3::new(
+                hash_to_unit(pcg_hash(i)),
+                hash_to_unit(pcg_hash(i + 77_777)),
+                0.37,
+            ) * 8.0;
             let v = perlin(p, 8, 5);
             assert!((-1.2..=1.2).contains(&v));
             sum += v;
@@ -296,13 +323,18 @@ mod tests {
         // Central-difference divergence of the decoded curl texture is small against its magnitude.
         let decode = |x: i32, y: i32| {
             let t = NoiseKind::Curl.texel(4, IVec3::new(x, y, 0));
-            (t[0] as f32 / 255.0 * 2.0 - 1.0, t[1] as f32 / 255.0 * 2.0 - 1.0)
+            (
+                t[0] as f32 / 255.0 * 2.0 - 1.0,
+                t[1] as f32 / 255.0 * 2.0 - 1.0,
+            )
         };
         let (mut div, mut mag) = (0.0, 0.0);
         for y in 0..32 {
             for x in 0..32 {
-                let d = (decode(x + 1, y).0 - decode(x - 1, y).0) + (decode(x, y + 1).1 - decode(x, y - 1).1);
-                let g = (decode(x + 1, y).0 - decode(x - 1, y).0).abs() + (decode(x, y + 1).0 - decode(x, y - 1).0).abs();
+                let d = (decode(x + 1, y).0 - decode(x - 1, y).0)
+                    + (decode(x, y + 1).1 - decode(x, y - 1).1);
+                let g = (decode(x + 1, y).0 - decode(x - 1, y).0).abs()
+                    + (decode(x, y + 1).0 - decode(x, y - 1).0).abs();
                 div += d.abs();
                 mag += g;
             }
@@ -318,7 +350,12 @@ mod tests {
         let t1 = crate::field::texture::unorm8(NoiseKind::Detail.texel(3, IVec3::new(5, 5, 6)));
         let centre = |x: f32| Vec3::new(x, 5.5, 6.5) / n;
         assert!((tex.sample(centre(4.5)) - t0).abs().max_element() < 1e-6);
-        assert!((tex.sample(centre(5.0)) - (t0 + t1) * 0.5).abs().max_element() < 1e-6);
+        assert!(
+            (tex.sample(centre(5.0)) - (t0 + t1) * 0.5)
+                .abs()
+                .max_element()
+                < 1e-6
+        );
         // Repeat addressing: one tile over is the same sample.
         assert!((tex.sample(centre(4.5) + Vec3::X) - t0).abs().max_element() < 1e-5);
     }

@@ -85,7 +85,7 @@ fn noise_perlin_fbm01(uvw: vec3<f32>, cells: i32, seed: u32) -> f32 {
     let sum = noise_perlin(uvw * f32(cells), cells, seed)
         + 0.5 * noise_perlin(uvw * f32(2 * cells), 2 * cells, seed ^ 0x51u)
         + 0.25 * noise_perlin(uvw * f32(4 * cells), 4 * cells, seed ^ 0xa3u);
-    return clamp(sum / 1.75 * 0.5 + 0.5, 0.0, 1.0);
+    return clamp(0.5 + 1.2 * sum, 0.0, 1.0); // PERLIN_CONTRAST
 }
 
 fn noise_remap(value: f32, lo0: f32, hi0: f32, lo1: f32, hi1: f32) -> f32 {
@@ -117,7 +117,7 @@ fn noise_curl_potential(seed: u32, texel: vec3<i32>, dx: i32, dy: i32) -> f32 {
 }
 
 fn noise_curl_texel(seed: u32, texel: vec3<i32>) -> vec4<f32> {
-    let scale = 128.0 / 16.0;
+    let scale = 2.0; // CURL_GAIN
     let vx = (noise_curl_potential(seed, texel, 0, 1) - noise_curl_potential(seed, texel, 0, -1)) * scale;
     let vy = -(noise_curl_potential(seed, texel, 1, 0) - noise_curl_potential(seed, texel, -1, 0)) * scale;
     return vec4<f32>(0.5 + 0.5 * vx, 0.5 + 0.5 * vy, 0.5, 1.0);

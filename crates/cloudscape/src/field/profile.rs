@@ -49,7 +49,12 @@ pub struct TypeTable {
 impl TypeTable {
     /// The table of a mix; weights need not sum to 1 but one must be positive.
     pub fn from_mix(mix: &CloudTypeMix) -> TypeTable {
-        let weights = [mix.stratus, mix.stratocumulus, mix.cumulus, mix.cumulonimbus];
+        let weights = [
+            mix.stratus,
+            mix.stratocumulus,
+            mix.cumulus,
+            mix.cumulonimbus,
+        ];
         let total: f32 = weights.iter().sum();
         let present: Vec<(f32, f32)> = weights
             .iter()
@@ -57,7 +62,11 @@ impl TypeTable {
             .filter(|(_, w)| **w > 0.0)
             .map(|(i, w)| (i as f32, w / total))
             .collect();
-        let mut table = TypeTable { first: present.first().map_or(2.0, |p| p.0), bounds: [2.0; 3], steps: [0.0; 3] };
+        let mut table = TypeTable {
+            first: present.first().map_or(2.0, |p| p.0),
+            bounds: [2.0; 3],
+            steps: [0.0; 3],
+        };
         let mut cumulative = 0.0;
         for (j, pair) in present.windows(2).enumerate() {
             cumulative += pair[0].1;
@@ -73,7 +82,9 @@ impl TypeTable {
         self.bounds
             .iter()
             .zip(self.steps)
-            .fold(self.first, |t, (b, s)| t + s * smoothstep(b - e, b + e, channel))
+            .fold(self.first, |t, (b, s)| {
+                t + s * smoothstep(b - e, b + e, channel)
+            })
     }
 }
 
@@ -93,18 +104,31 @@ mod tests {
         assert!(height_gradient(0.0, 0.075) > 0.9);
         assert!(height_gradient(2.0, 0.5) > 0.99, "cumulus fills the middle");
         assert_eq!(height_gradient(2.0, 1.0), 0.0);
-        assert!(height_gradient(3.0, 0.95) > 0.4, "cumulonimbus reaches the top");
+        assert!(
+            height_gradient(3.0, 0.95) > 0.4,
+            "cumulonimbus reaches the top"
+        );
     }
 
     #[test]
     fn mix_maps_channel_through_cumulative_weights() {
-        let mix = CloudTypeMix { stratocumulus: 0.3, cumulus: 0.7, ..CloudTypeMix::default() };
+        let mix = CloudTypeMix {
+            stratocumulus: 0.3,
+            cumulus: 0.7,
+            ..CloudTypeMix::default()
+        };
         let t = TypeTable::from_mix(&mix);
         assert_eq!(t.type_coord(0.0), 1.0);
         assert!((t.type_coord(0.2) - 1.0).abs() < 1e-6);
-        assert!((t.type_coord(0.3) - 1.5).abs() < 1e-6, "halfway at the bound");
+        assert!(
+            (t.type_coord(0.3) - 1.5).abs() < 1e-6,
+            "halfway at the bound"
+        );
         assert!((t.type_coord(0.9) - 2.0).abs() < 1e-6);
-        let single = TypeTable::from_mix(&CloudTypeMix { cumulonimbus: 2.0, ..CloudTypeMix::default() });
+        let single = TypeTable::from_mix(&CloudTypeMix {
+            cumulonimbus: 2.0,
+            ..CloudTypeMix::default()
+        });
         assert_eq!(single.type_coord(0.5), 3.0);
     }
 }

@@ -26,24 +26,35 @@ impl Weather {
             (WeatherSource::File, Some(path)) => {
                 let texture = read_png(path)?;
                 let aspect = texture.dims.y as f32 / texture.dims.x as f32;
-                Ok(Weather { texture, extent_m: Vec2::new(extent, extent * aspect) })
+                Ok(Weather {
+                    texture,
+                    extent_m: Vec2::new(extent, extent * aspect),
+                })
             }
-            (WeatherSource::File, None) => Err("weather.source = \"file\" needs weather.path".into()),
+            (WeatherSource::File, None) => {
+                Err("weather.source = \"file\" needs weather.path".into())
+            }
             (WeatherSource::Procedural, _) => {
                 let cells = (map.extent_km / map.feature_size_km).round().max(1.0) as i32;
-                Ok(Weather { texture: procedural(map.seed, map.resolution, cells), extent_m: Vec2::splat(extent) })
+                Ok(Weather {
+                    texture: procedural(map.seed, map.resolution, cells),
+                    extent_m: Vec2::splat(extent),
+                })
             }
         }
     }
 
     /// (coverage, type, density) at world position `xz` in metres, linear-filtered and repeating.
     pub fn sample(&self, xz: Vec2) -> Vec3 {
-        self.texture.sample((xz / self.extent_m).extend(0.0)).truncate()
+        self.texture
+            .sample((xz / self.extent_m).extend(0.0))
+            .truncate()
     }
 }
 
 fn read_png(path: &Path) -> Result<Texture8, String> {
-    let img = image::open(path).map_err(|e| format!("cannot read weather map {}: {e}", path.display()))?;
+    let img = image::open(path)
+        .map_err(|e| format!("cannot read weather map {}: {e}", path.display()))?;
     let rgba = img.to_rgba8();
     let dims = UVec3::new(rgba.width(), rgba.height(), 1);
     let texels = rgba.pixels().map(|p| p.0).collect();
@@ -73,7 +84,10 @@ pub fn procedural(seed: u32, resolution: u32, cells: i32) -> Texture8 {
             [coverage[i], kind[i], d, 1.0].map(super::noise::quantize_unorm8)
         })
         .collect();
-    Texture8 { dims: UVec3::new(resolution, resolution, 1), texels }
+    Texture8 {
+        dims: UVec3::new(resolution, resolution, 1),
+        texels,
+    }
 }
 
 /// Four octaves of periodic 2D Perlin noise (a z = const slice of the 3D noise), about -0.5..0.5.
@@ -82,7 +96,11 @@ fn fbm2(uv: Vec2, cells: i32, seed: u32) -> f32 {
     (0..4)
         .map(|o| {
             let c = cells << o;
-            perlin(Vec3::new(uv.x * c as f32, uv.y * c as f32, z), c, seed ^ o as u32) * 0.5f32.powi(o)
+            perlin(
+                Vec3::new(uv.x * c as f32, uv.y * c as f32, z),
+                c,
+                seed ^ o as u32,
+            ) * 0.5f32.powi(o)
         })
         .sum::<f32>()
         / 1.875
@@ -109,18 +127,36 @@ mod tests {
         let t = procedural(5, 64, 4);
         let cov: Vec<f32> = t.texels.iter().map(|p| p[0] as f32 / 255.0).collect();
         let below_half = cov.iter().filter(|&&c| c < 0.5).count() as f32 / cov.len() as f32;
-        assert!((below_half - 0.5).abs() < 0.02, "equalised coverage: {below_half}");
+        assert!(
+            (below_half - 0.5).abs() < 0.02,
+            "equalised coverage: {below_half}"
+        );
         let density_min = t.texels.iter().map(|p| p[2]).min().unwrap();
         assert!(density_min as f32 / 255.0 >= 0.6 - 1e-2);
         // Opposite edges are neighbours on the torus: far closer than random pairs.
-        let edge_diff: f32 = (0..64).map(|y| (t.fetch(glam::IVec3::new(0, y, 0)) - t.fetch(glam::IVec3::new(63, y, 0))).x.abs()).sum();
-        let far_diff: f32 = (0..64).map(|y| (t.fetch(glam::IVec3::new(0, y, 0)) - t.fetch(glam::IVec3::new(32, y, 0))).x.abs()).sum();
+        let edge_diff: f32 = (0..64)
+            .map(|y| {
+                (t.fetch(glam::IVec3::new(0, y, 0)) - t.fetch(glam::IVec3::new(63, y, 0)))
+                    .x
+                    .abs()
+            })
+            .sum();
+        let far_diff: f32 = (0..64)
+            .map(|y| {
+                (t.fetch(glam::IVec3::new(0, y, 0)) - t.fetch(glam::IVec3::new(32, y, 0)))
+                    .x
+                    .abs()
+            })
+            .sum();
         assert!(edge_diff < 0.5 * far_diff, "{edge_diff} vs {far_diff}");
     }
 
     #[test]
     fn missing_file_is_a_clear_error() {
-        let map = WeatherMap { source: WeatherSource::File, ..WeatherMap::default() };
+        let map = WeatherMap {
+            source: WeatherSource::File,
+            ..WeatherMap::default()
+        };
         let err = Weather::from_scene(&map, Some(Path::new("/nonexistent/w.png"))).unwrap_err();
         assert!(err.contains("/nonexistent/w.png"), "{err}");
     }

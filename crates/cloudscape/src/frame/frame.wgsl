@@ -7,7 +7,7 @@ struct Frame {
     sun_direction: vec4<f32>,   // unit vector toward the sun, cos(angular radius)
     sun_irradiance: vec4<f32>,  // rgb irradiance facing the sun, angular radius (rad)
     sky_zenith: vec4<f32>,      // rgb radiance straight up, gradient exponent
-    sky_horizon: vec4<f32>,     // rgb radiance at the horizon
+    sky_horizon: vec4<f32>,     // rgb radiance at the horizon, haze extinction (m^-1)
     sky_mean_up: vec4<f32>,     // rgb mean radiance over the upper hemisphere
     ground_albedo: vec4<f32>,   // rgb albedo, 1 if there is a ground
     ground_radiance: vec4<f32>, // rgb radiance leaving the unshadowed ground
@@ -32,10 +32,15 @@ fn frame_sky_radiance(frame: Frame, dir: vec3<f32>) -> vec3<f32> {
     return mix(frame.sky_horizon.xyz, frame.sky_zenith.xyz, pow(max(dir.y, 0.0), frame.sky_zenith.w));
 }
 
-// Interleaved gradient noise (Jimenez 2014, "Next Generation Post Processing in Call of Duty:
-// Advanced Warfare"): a per-pixel value in [0, 1) whose neighbours differ, turning banding into
-// fine noise.
-fn frame_pixel_jitter(pixel: vec2<f32>, index: f32) -> f32 {
-    let p = pixel + 5.588238 * index;
-    return fract(52.9829189 * fract(dot(p, vec2<f32>(0.06711056, 0.00583715))));
+// Radiance `radiance` seen from `distance_m` away through the haze: it fades toward the horizon
+// radiance as exp(-haze distance), weighted by `coverage` (1 - transmittance for clouds).
+fn frame_haze(frame: Frame, radiance: vec3<f32>, coverage: f32, distance_m: f32) -> vec3<f32> {
+    let clear = exp(-frame.sky_horizon.w * distance_m);
+    return radiance * clear + frame.sky_horizon.xyz * coverage * (1.0 - clear);
+}
+
+// A per-pixel, per-frame value in [0, 1): white noise from the PCG hash (noise.wgsl), which turns
+// step banding into grain without the visible pattern of structured dithers at low sample counts.
+fn frame_pixel_jitter(pixel: vec2<u32>, index: u32) -> f32 {
+    return noise_hash_to_unit(noise_pcg_hash(pixel.x ^ noise_pcg_hash(pixel.y ^ noise_pcg_hash(index))));
 }

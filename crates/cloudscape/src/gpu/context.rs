@@ -178,6 +178,16 @@ impl GpuContext {
         self.adapter.features()
     }
 
+    /// Blocks until the GPU has finished all submitted work.
+    ///
+    /// # Panics
+    /// When the device is lost.
+    pub fn wait_idle(&self) {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .unwrap_or_else(|error| panic!("the GPU device was lost: {error}"));
+    }
+
     /// The shared context of GPU tests.
     ///
     /// Honours the environment variable [`TEST_BACKEND_ENV`] (`vulkan` or `gl`); without it any

@@ -11,3 +11,4 @@ pub mod timing;
 pub use context::{Backend, GpuContext, GpuError, GpuOptions};
 pub use readback::{read_buffer, read_texture, read_texture_rgba16f, read_texture_rgba32f};
 pub use timing::PassTimer;
+pub mod pipeline;

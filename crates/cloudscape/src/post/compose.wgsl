@@ -23,8 +23,9 @@ fn compose_background(@builtin(global_invocation_id) id: vec3<u32>) {
     let o = frame.camera_position.xyz;
     let d = frame_ray_direction(frame, pixel);
     var background = frame_sky_radiance(frame, d) + compose_sun_disc(d);
-    if field_ground_distance(o, d, frame.ground_albedo.w > 0.5) < frame.camera_position.w {
-        background = frame.ground_radiance.xyz;
+    let ground_m = field_ground_distance(o, d, frame.ground_albedo.w > 0.5);
+    if ground_m < frame.camera_position.w {
+        background = frame_haze(frame, frame.ground_radiance.xyz, 1.0, ground_m);
     }
     let clouds = textureLoad(compose_clouds, vec2<i32>(id.xy), 0);
     textureStore(compose_out, vec2<i32>(id.xy), vec4<f32>(background * clouds.a + clouds.rgb, 1.0));

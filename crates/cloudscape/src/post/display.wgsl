@@ -2,7 +2,7 @@
 
 struct Display {
     exposure_scale: f32, // 2^EV
-    operator: u32,       // 0 ACES, 1 AgX
+    tonemap_operator: u32, // 0 ACES, 1 AgX
 }
 
 @group(0) @binding(0) var<uniform> display: Display;
@@ -17,7 +17,7 @@ fn display_hdr_image(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let radiance = textureLoad(display_hdr, vec2<i32>(id.xy), 0).rgb * display.exposure_scale;
     var mapped: vec3<f32>;
-    if display.operator == 0u {
+    if display.tonemap_operator == 0u {
         mapped = tonemap_aces(radiance);
     } else {
         mapped = tonemap_agx(radiance);

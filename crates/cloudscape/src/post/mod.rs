@@ -3,10 +3,13 @@
 
 pub mod tonemap;
 
-use crate::field::gpu::{FIELD_WGSL, FieldGpu};
-use crate::gpu::pipeline::{UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d, float_texture, storage_texture_2d};
+use crate::field::gpu::{FIELD_WGSL, FieldGpu, NOISE_WGSL};
 use crate::frame::{FRAME_WGSL, Frame};
 use crate::gpu::GpuContext;
+use crate::gpu::pipeline::{
+    UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d, float_texture,
+    storage_texture_2d,
+};
 use crate::scene::Tonemap;
 use wgpu::util::DeviceExt;
 
@@ -20,7 +23,7 @@ pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 /// Source of the compose program.
 pub fn compose_source() -> String {
-    [FIELD_WGSL, FRAME_WGSL, COMPOSE_WGSL].concat()
+    [NOISE_WGSL, FIELD_WGSL, FRAME_WGSL, COMPOSE_WGSL].concat()
 }
 
 /// Source of the display program.
@@ -39,15 +42,29 @@ impl Background {
     /// Builds the pass against the field's bind group (for the planet's shape).
     pub fn new(ctx: &GpuContext, field: &FieldGpu) -> Background {
         let d2 = wgpu::TextureViewDimension::D2;
-        let layout = bind_group_layout(&ctx.device, "compose", &[UNIFORM, float_texture(d2), storage_texture_2d(HDR_FORMAT)]);
-        let pipeline = compute_pipeline(ctx, "compose", &compose_source(), "compose_background", &[field.layout(), &layout]);
+        let layout = bind_group_layout(
+            &ctx.device,
+            "compose",
+            &[UNIFORM, float_texture(d2), storage_texture_2d(HDR_FORMAT)],
+        );
+        let pipeline = compute_pipeline(
+            ctx,
+            "compose",
+            &compose_source(),
+            "compose_background",
+            &[field.layout(), &layout],
+        );
         let frame = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("compose frame"),
             size: size_of::<crate::frame::FrameUniform>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Background { pipeline, layout, frame }
+        Background {
+            pipeline,
+            layout,
+            frame,
+        }
     }
 
     /// Records `hdr = background * clouds.a + clouds.rgb` for `frame`.
@@ -60,13 +77,25 @@ impl Background {
         (clouds, hdr): (&wgpu::TextureView, &wgpu::TextureView),
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
-        ctx.queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame.uniform()));
-        let group = bind_group(&ctx.device, &self.layout, &[
-            self.frame.as_entire_binding(),
-            wgpu::BindingResource::TextureView(clouds),
-            wgpu::BindingResource::TextureView(hdr),
-        ]);
-        dispatch_2d(encoder, "compose", &self.pipeline, &[field.bind_group(), &group], frame.size, timestamps);
+        ctx.queue
+            .write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame.uniform()));
+        let group = bind_group(
+            &ctx.device,
+            &self.layout,
+            &[
+                self.frame.as_entire_binding(),
+                wgpu::BindingResource::TextureView(clouds),
+                wgpu::BindingResource::TextureView(hdr),
+            ],
+        );
+        dispatch_2d(
+            encoder,
+            "compose",
+            &self.pipeline,
+            &[field.bind_group(), &group],
+            frame.size,
+            timestamps,
+        );
     }
 }
 
@@ -79,8 +108,22 @@ pub struct Display {
 impl Display {
     /// Builds the pass.
     pub fn new(ctx: &GpuContext) -> Display {
-        let layout = bind_group_layout(&ctx.device, "display", &[UNIFORM, float_texture(wgpu::TextureViewDimension::D2), storage_texture_2d(DISPLAY_FORMAT)]);
-        let pipeline = compute_pipeline(ctx, "display", &display_source(), "display_hdr_image", &[&layout]);
+        let layout = bind_group_layout(
+            &ctx.device,
+            "display",
+            &[
+                UNIFORM,
+                float_texture(wgpu::TextureViewDimension::D2),
+                storage_texture_2d(DISPLAY_FORMAT),
+            ],
+        );
+        let pipeline = compute_pipeline(
+            ctx,
+            "display",
+            &display_source(),
+            "display_hdr_image",
+            &[&layout],
+        );
         Display { pipeline, layout }
     }
 
@@ -95,16 +138,29 @@ impl Display {
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
         let params = [2f32.powf(exposure_ev).to_bits(), operator as u32, 0, 0];
-        let uniform = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("display"),
-            contents: bytemuck::cast_slice(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let group = bind_group(&ctx.device, &self.layout, &[
-            uniform.as_entire_binding(),
-            wgpu::BindingResource::TextureView(hdr),
-            wgpu::BindingResource::TextureView(out),
-        ]);
-        dispatch_2d(encoder, "display", &self.pipeline, &[&group], size, timestamps);
+        let uniform = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("display"),
+                contents: bytemuck::cast_slice(&params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+        let group = bind_group(
+            &ctx.device,
+            &self.layout,
+            &[
+                uniform.as_entire_binding(),
+                wgpu::BindingResource::TextureView(hdr),
+                wgpu::BindingResource::TextureView(out),
+            ],
+        );
+        dispatch_2d(
+            encoder,
+            "display",
+            &self.pipeline,
+            &[&group],
+            size,
+            timestamps,
+        );
     }
 }

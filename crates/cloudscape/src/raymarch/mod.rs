@@ -2,10 +2,12 @@
 //! that writes, per pixel, the radiance the clouds scatter toward the eye (rgb) and the transmittance
 //! through them (a), stopping at the host's depth buffer. Composite as `scene * a + rgb`.
 
-use crate::field::gpu::{FIELD_WGSL, FieldGpu};
-use crate::gpu::pipeline::{UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d, storage_texture_2d};
+use crate::field::gpu::{FIELD_WGSL, FieldGpu, NOISE_WGSL};
 use crate::frame::{FRAME_WGSL, Frame};
 use crate::gpu::GpuContext;
+use crate::gpu::pipeline::{
+    UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d, storage_texture_2d,
+};
 use crate::optics::{PHASE_WGSL, PhaseLobes};
 use crate::scene::{Quality, Scene};
 use bytemuck::{Pod, Zeroable};
@@ -18,7 +20,14 @@ pub const CLOUD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// Source of the ray-march program.
 pub fn shader_source() -> String {
-    [FIELD_WGSL, FRAME_WGSL, PHASE_WGSL, RAYMARCH_WGSL].concat()
+    [
+        NOISE_WGSL,
+        FIELD_WGSL,
+        FRAME_WGSL,
+        PHASE_WGSL,
+        RAYMARCH_WGSL,
+    ]
+    .concat()
 }
 
 /// Step counts and lighting of the march.
@@ -63,7 +72,11 @@ impl MarchSettings {
             light_steps: r.light_steps.unwrap_or(light),
             samples_per_pixel: r.samples_per_pixel.unwrap_or(spp),
             octaves: l.octaves,
-            octave_factors: [l.octave_attenuation, l.octave_contribution, l.octave_eccentricity],
+            octave_factors: [
+                l.octave_attenuation,
+                l.octave_contribution,
+                l.octave_eccentricity,
+            ],
             albedo: l.albedo,
             ambient_scale: l.ambient_scale,
             phase: PhaseLobes::from_scene(&scene.phase),
@@ -106,8 +119,18 @@ impl RaymarchRenderer {
             view_dimension: wgpu::TextureViewDimension::D2,
             multisampled: false,
         };
-        let layout = bind_group_layout(&ctx.device, "raymarch", &[UNIFORM, UNIFORM, depth, storage_texture_2d(CLOUD_FORMAT)]);
-        let pipeline = compute_pipeline(ctx, "raymarch", &shader_source(), "march_clouds", &[field.layout(), &layout]);
+        let layout = bind_group_layout(
+            &ctx.device,
+            "raymarch",
+            &[UNIFORM, UNIFORM, depth, storage_texture_2d(CLOUD_FORMAT)],
+        );
+        let pipeline = compute_pipeline(
+            ctx,
+            "raymarch",
+            &shader_source(),
+            "march_clouds",
+            &[field.layout(), &layout],
+        );
         let buffer = |label, size| {
             ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -119,7 +142,10 @@ impl RaymarchRenderer {
         RaymarchRenderer {
             pipeline,
             layout,
-            frame: buffer("raymarch frame", size_of::<crate::frame::FrameUniform>() as u64),
+            frame: buffer(
+                "raymarch frame",
+                size_of::<crate::frame::FrameUniform>() as u64,
+            ),
             march: buffer("raymarch settings", size_of::<MarchUniform>() as u64),
             settings: MarchUniform::zeroed(),
         }
@@ -129,14 +155,26 @@ impl RaymarchRenderer {
     pub fn prepare(&mut self, ctx: &GpuContext, frame: &Frame, settings: &MarchSettings) {
         let [a, b, c] = settings.octave_factors;
         self.settings = MarchUniform {
-            counts: UVec4::new(settings.primary_steps, settings.light_steps, settings.samples_per_pixel, settings.octaves),
+            counts: UVec4::new(
+                settings.primary_steps,
+                settings.light_steps,
+                settings.samples_per_pixel,
+                settings.octaves,
+            ),
             octaves: Vec4::new(a, b, c, settings.albedo),
             phase: Vec4::from_array(settings.phase.to_gpu()),
-            ambient: Vec4::new(settings.ambient_scale, 0.0, 0.0, 0.0),
+            ambient: Vec4::new(
+                settings.ambient_scale,
+                settings.phase.mean_cosine(),
+                0.0,
+                0.0,
+            ),
             tile: UVec4::ZERO,
         };
-        ctx.queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame.uniform()));
-        ctx.queue.write_buffer(&self.march, 0, bytemuck::bytes_of(&self.settings));
+        ctx.queue
+            .write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame.uniform()));
+        ctx.queue
+            .write_buffer(&self.march, 0, bytemuck::bytes_of(&self.settings));
     }
 
     /// Records the march over the pixel rectangle at `origin` of `size` pixels (the whole frame, or
@@ -153,14 +191,26 @@ impl RaymarchRenderer {
     ) {
         if self.settings.tile.truncate().truncate() != origin {
             self.settings.tile = origin.extend(0).extend(0);
-            ctx.queue.write_buffer(&self.march, 0, bytemuck::bytes_of(&self.settings));
+            ctx.queue
+                .write_buffer(&self.march, 0, bytemuck::bytes_of(&self.settings));
         }
-        let group = bind_group(&ctx.device, &self.layout, &[
-            self.frame.as_entire_binding(),
-            self.march.as_entire_binding(),
-            wgpu::BindingResource::TextureView(targets.depth),
-            wgpu::BindingResource::TextureView(targets.clouds),
-        ]);
-        dispatch_2d(encoder, "raymarch", &self.pipeline, &[field.bind_group(), &group], size, timestamps);
+        let group = bind_group(
+            &ctx.device,
+            &self.layout,
+            &[
+                self.frame.as_entire_binding(),
+                self.march.as_entire_binding(),
+                wgpu::BindingResource::TextureView(targets.depth),
+                wgpu::BindingResource::TextureView(targets.clouds),
+            ],
+        );
+        dispatch_2d(
+            encoder,
+            "raymarch",
+            &self.pipeline,
+            &[field.bind_group(), &group],
+            size,
+            timestamps,
+        );
     }
 }

@@ -5,7 +5,7 @@ struct March {
     counts: vec4<u32>,  // primary steps, light steps, samples per pixel, octaves
     octaves: vec4<f32>, // attenuation a, contribution b, eccentricity c, single-scattering albedo
     phase: vec4<f32>,   // phase lobes (optics::PhaseLobes::to_gpu)
-    ambient: vec4<f32>, // ambient scale
+    ambient: vec4<f32>, // ambient scale, phase mean cosine g
     tile: vec4<u32>,    // origin of the pixel tile this dispatch covers
 }
 
@@ -16,6 +16,9 @@ struct March {
 
 // Rays stop once this little light gets through (VolumeCloud's threshold, peers.md).
 const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
+// Longest path toward the sun (m): past 4 km of cumulus (optical depth ~ 200 at 0.05 m^-1) a shadow
+// is complete, and longer single-sample segments only add noise.
+const MARCH_SUN_PATH_MAX_M: f32 = 4000.0;
 
 // The first stretch of the ray, within [0, t_max], inside the layers' altitude band.
 fn march_layer_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
@@ -54,13 +57,13 @@ fn march_volume_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
 }
 
 // Optical depth toward the sun from p: `light_steps` segments whose lengths double, covering the way
-// to the top of the layers (at most 8 km), each sampled at a jittered point (VolumeCloud samples the
+// to the top of the layers (at most MARCH_SUN_PATH_MAX_M), each sampled at a jittered point (VolumeCloud samples the
 // sun path at 0.5, 1.5, 3, 6, 12 units with weights 1, 1, 2, 4, 8; peers.md).
 fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
     let sun = frame.sun_direction.xyz;
-    var length_m = 8000.0;
+    var length_m = MARCH_SUN_PATH_MAX_M;
     if field.counts.x > 0u {
-        length_m = clamp(field_below(p, sun, field.planet.w).y, 50.0, 8000.0);
+        length_m = clamp(field_below(p, sun, field.planet.w).y, 50.0, MARCH_SUN_PATH_MAX_M);
     }
     let n = march.counts.y;
     let unit = length_m / f32((1u << n) - 1u);
@@ -68,19 +71,27 @@ fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
     var start = 0.0;
     for (var k = 0u; k < n; k++) {
         let width = unit * f32(1u << k);
-        tau += field_extinction(p + sun * (start + width * jitter)) * width;
+        let offset = fract(jitter + f32(k + 1u) * 0.618034); // decorrelated from the view jitter
+        tau += field_extinction(p + sun * (start + width * offset)) * width;
         start += width;
     }
     return tau;
 }
 
+// Eddington (two-stream) diffuse transmittance of a conservatively scattering slab of optical depth
+// tau and asymmetry g: 1 / (1 + 3/4 (1 - g) tau) (e.g. Bohren 1987, "Multiple scattering of light
+// and some of its observable consequences", Am. J. Phys. 55): diffuse light is dimmed by the
+// transport optical depth and only algebraically, not exponentially.
+fn march_diffuse_transmittance(tau: f32) -> f32 {
+    return 1.0 / (1.0 + 0.75 * (1.0 - march.ambient.y) * tau);
+}
+
 // Light scattered from the sky above and the ground below, per unit sigma_s: each hemisphere
-// contributes half its mean radiance (isotropic estimate), dimmed by the optical depth to the top
-// (bottom) of the layer estimated from one sample halfway, with multiple scattering's softer
-// attenuation exp(-a tau) (Wrenninge 2013's octave factor a).
+// contributes half its mean radiance (isotropic estimate), dimmed by the diffuse transmittance of
+// the cloud between the point and the top (bottom) of the layer, its optical depth estimated from
+// one sample halfway.
 fn march_ambient(p: vec3<f32>, h: f32) -> vec3<f32> {
     let up = field_up(p);
-    let a = march.octaves.x;
     var above = 500.0;
     var below = 500.0;
     if field.counts.x > 0u && h >= field.planet.z && h <= field.planet.w {
@@ -94,7 +105,7 @@ fn march_ambient(p: vec3<f32>, h: f32) -> vec3<f32> {
         ground = frame.sky_horizon.xyz;
     }
     let sky = frame.sky_mean_up.xyz;
-    return march.ambient.x * 0.5 * (sky * exp(-a * tau_up) + ground * exp(-a * tau_down));
+    return march.ambient.x * 0.5 * (sky * march_diffuse_transmittance(tau_up) + ground * march_diffuse_transmittance(tau_down));
 }
 
 // Sun light scattered toward the eye per unit sigma_s, with multiple-scattering octaves
@@ -113,17 +124,37 @@ fn march_sun_scattering(cos_theta: f32, tau_sun: f32) -> vec3<f32> {
     return sum * frame.sun_irradiance.xyz;
 }
 
-// Integrates [t0, t1] in `primary_steps` equal steps offset by `jitter`, with Hillaire 2016's
-// energy-conserving step: S_int = (S - S exp(-sigma_t dt)) / sigma_t; L += T S_int; T *= exp(-sigma_t dt).
+// Ray parameter of stratum boundary u in [0, 1]: quadratic spacing, so strata start short where
+// the ray enters the clouds (the surfaces the eye sees) and lengthen behind them.
+fn march_stratum_t(t0: f32, t1: f32, u: f32) -> f32 {
+    return t0 + (t1 - t0) * u * u;
+}
+
+// Strata for a segment of `length_m`: the preset's count over twice the layer band's thickness,
+// up to four times as many for the long grazing rays that cross the layer toward the horizon or
+// along it from inside.
+fn march_step_count(length_m: f32) -> u32 {
+    let band_m = max(field.planet.w - field.planet.z, 1.0);
+    let scale = clamp(length_m / (2.0 * band_m), 1.0, 4.0);
+    return u32(f32(march.counts.x) * scale);
+}
+
+// Integrates [t0, t1] in `march_step_count` strata, one sample per stratum at fraction `jitter` of it,
+// with Hillaire 2016's energy-conserving step: S_int = (S - S exp(-sigma_t dt)) / sigma_t;
+// L += T S_int; T *= exp(-sigma_t dt).
 fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32) -> vec4<f32> {
-    let n = march.counts.x;
-    let dt = (t1 - t0) / f32(n);
+    let n = march_step_count(t1 - t0);
     let cos_theta = dot(d, frame.sun_direction.xyz);
     let albedo = march.octaves.w;
     var radiance = vec3<f32>(0.0);
     var transmittance = 1.0;
+    var depth_weighted = 0.0;
+    var t_start = t0;
     for (var i = 0u; i < n; i++) {
-        let p = o + d * (t0 + (f32(i) + jitter) * dt);
+        let t_end = march_stratum_t(t0, t1, f32(i + 1u) / f32(n));
+        let dt = t_end - t_start;
+        let p = o + d * (t_start + jitter * dt);
+        t_start = t_end;
         let sigma_t = field_extinction(p);
         if sigma_t <= 0.0 {
             continue;
@@ -133,12 +164,16 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32) -> v
         let source = albedo * (march_sun_scattering(cos_theta, tau_sun) + march_ambient(p, h));
         let step_transmittance = exp(-sigma_t * dt);
         radiance += transmittance * source * (1.0 - step_transmittance);
+        depth_weighted += transmittance * (1.0 - step_transmittance) * distance(p, o);
         transmittance *= step_transmittance;
         if transmittance < MARCH_MIN_TRANSMITTANCE {
             break;
         }
     }
-    return vec4<f32>(radiance, transmittance);
+    // Aerial perspective at the transmittance-weighted mean cloud depth (Hillaire 2016, 5.9.1).
+    let coverage = 1.0 - transmittance;
+    let depth = select(0.0, depth_weighted / coverage, coverage > 0.0);
+    return vec4<f32>(frame_haze(frame, radiance, coverage, depth), transmittance);
 }
 
 @compute @workgroup_size(8, 8)
@@ -161,11 +196,12 @@ fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     let t1 = max(select(-FIELD_NO_HIT, layer.y, layer.x < layer.y), volume.y);
     var result = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     if t0 < t1 {
+        // Samples of one pixel are stratified: offsets s / spp from one per-pixel jitter.
         let spp = march.counts.z;
+        let pixel_jitter = frame_pixel_jitter(px, u32(frame.viewport.w));
         var sum = vec4<f32>(0.0);
         for (var s = 0u; s < spp; s++) {
-            let jitter = frame_pixel_jitter(pixel, frame.viewport.w * f32(spp) + f32(s));
-            sum += march_segment(o, d, t0, t1, jitter);
+            sum += march_segment(o, d, t0, t1, fract(pixel_jitter + f32(s) / f32(spp)));
         }
         result = sum / f32(spp);
     }

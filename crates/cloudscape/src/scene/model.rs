@@ -144,6 +144,9 @@ pub struct Sky {
     pub horizon_radiance: [f32; 3],
     /// Gradient sky: how fast the horizon colour gives way to the zenith colour, 0.05..10.
     pub gradient_exponent: f32,
+    /// Meteorological visibility in metres, 100..10 000 000: distant clouds and ground fade into the
+    /// horizon radiance with extinction 3.912 / visibility (Koschmieder).
+    pub visibility_m: f32,
 }
 
 impl Default for Sky {
@@ -154,6 +157,7 @@ impl Default for Sky {
             zenith_radiance: [0.10, 0.22, 0.52],
             horizon_radiance: [0.42, 0.50, 0.62],
             gradient_exponent: 0.45,
+            visibility_m: 80_000.0,
         }
     }
 }
@@ -248,7 +252,8 @@ pub struct CloudLayer {
     pub bottom_m: f32,
     /// Thickness of the layer, metres, 10..20 000.
     pub thickness_m: f32,
-    /// Cloud cover, 0..1: 0 clears the layer, 0.5 keeps the weather map as painted, 1 fills it.
+    /// Cloud cover, 0..1: the fraction of the sky the layer covers (calibrated on cumulus); 0 clears
+    /// the layer, 1 fills it.
     pub coverage: f32,
     /// Extinction coefficient of the densest cloud, m^-1, 0..1 (cumulus 0.04-0.1, physics.md).
     pub extinction_per_m: f32,
@@ -266,7 +271,7 @@ impl Default for CloudLayer {
         CloudLayer {
             bottom_m: 1500.0,
             thickness_m: 2200.0,
-            coverage: 0.55,
+            coverage: 0.45,
             extinction_per_m: 0.05,
             types: cumulus_only(),
             wind_m_per_s: [8.0, 3.0],

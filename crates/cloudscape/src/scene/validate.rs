@@ -148,6 +148,7 @@ const SCENE_RULES: &[Rule<Scene>] = &[
     rule("sky.zenith_radiance", AtLeast(0.0), "", |s| Floats(&s.sky.zenith_radiance)),
     rule("sky.horizon_radiance", AtLeast(0.0), "", |s| Floats(&s.sky.horizon_radiance)),
     rule("sky.gradient_exponent", Between(0.05, 10.0), "", |s| Float(s.sky.gradient_exponent)),
+    rule("sky.visibility_m", Between(100.0, 1.0e7), "m", |s| Float(s.sky.visibility_m)),
     rule("ground.albedo", Between(0.0, 1.0), "", |s| Floats(&s.ground.albedo)),
     rule("planet.radius_m", Between(1.0e3, 1.0e8), "m", |s| Float(s.planet.radius_m)),
     rule("weather.extent_km", Between(0.1, 1.0e4), "km", |s| Float(s.weather.extent_km)),

@@ -1,0 +1,82 @@
+//! `cloudscape export`: the cloud field over a box as a Mitsuba 3 `.vol` grid and scene.
+
+use crate::common::{SceneArgs, Stages};
+use anyhow::{Result, anyhow};
+use clap::Args;
+use cloudscape::export::write_mitsuba_scene;
+use cloudscape::field::{CloudField, VoxelGrid};
+use glam::Vec3;
+use std::path::PathBuf;
+
+/// Arguments of `cloudscape export`.
+#[derive(Args, Debug)]
+pub struct ExportArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Directory to write `clouds.vol` and `scene.xml` into (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    /// Voxels along the longest side of the box.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(2..=2048))]
+    resolution: u32,
+    /// Horizontal side of the box around the camera for layered clouds, km.
+    #[arg(long, default_value_t = 16.0)]
+    size_km: f32,
+}
+
+/// The world box the export samples: the layers' altitude band over a square around the camera,
+/// joined with every voxel grid's box.
+fn export_box(field: &CloudField, camera: Vec3, size_m: f32) -> Option<(Vec3, Vec3)> {
+    let layers = field.altitude_range_m().map(|(bottom, top)| {
+        let half = Vec3::new(size_m * 0.5, 0.0, size_m * 0.5);
+        (
+            Vec3::new(camera.x, bottom, camera.z) - half,
+            Vec3::new(camera.x, top, camera.z) + half,
+        )
+    });
+    let volumes = field.volumes.iter().map(|v| (v.min_m, v.min_m + v.size_m));
+    layers
+        .into_iter()
+        .chain(volumes)
+        .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+}
+
+/// Samples the field and writes the Mitsuba scene.
+pub fn run(args: ExportArgs) -> Result<()> {
+    let mut stages = Stages::new();
+    let doc = stages.run("loading scene", || args.scene.load(&[]))?;
+    let scene = &doc.scene;
+    let field = stages.run("building cloud field", || {
+        CloudField::new(scene, &doc.resolve_path(""))
+            .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))
+    })?;
+    let camera = Vec3::from_array(scene.camera.position_m);
+    let (min, max) = export_box(&field, camera, args.size_km * 1000.0)
+        .ok_or_else(|| anyhow!("the scene has no clouds to export"))?;
+    let extent = max - min;
+    let voxel_m = extent.max_element() / args.resolution as f32;
+    let resolution = (extent / voxel_m)
+        .ceil()
+        .max(Vec3::ONE)
+        .as_uvec3()
+        .to_array();
+    eprintln!("sampling {resolution:?} voxels over {min} .. {max} m");
+    stages.run("baking noise", || Ok(field.bake_noise()))?;
+    let time_s = scene.render.time_s;
+    let sigma = stages.run("sampling field", || {
+        Ok(VoxelGrid::from_fn(resolution, min, max, |p| {
+            field.extinction_per_m(p, time_s)
+        }))
+    })?;
+    let peak = sigma.max_value().max(f32::MIN_POSITIVE);
+    let normalised = VoxelGrid {
+        values: sigma.values.iter().map(|v| v / peak).collect(),
+        ..sigma
+    };
+    let path = stages.run("writing", || {
+        Ok(write_mitsuba_scene(&args.out, scene, &normalised, peak)?)
+    })?;
+    eprintln!("wrote {} (peak extinction {peak:.4} m^-1)", path.display());
+    stages.print();
+    Ok(())
+}
