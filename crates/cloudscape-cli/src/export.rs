@@ -61,7 +61,10 @@ pub fn run(args: ExportArgs) -> Result<()> {
         .as_uvec3()
         .to_array();
     eprintln!("sampling {resolution:?} voxels over {min} .. {max} m");
-    stages.run("baking noise", || Ok(field.bake_noise()))?;
+    stages.run("baking noise", || {
+        field.bake_noise();
+        Ok(())
+    })?;
     let time_s = scene.render.time_s;
     let sigma = stages.run("sampling field", || {
         Ok(VoxelGrid::from_fn(resolution, min, max, |p| {
