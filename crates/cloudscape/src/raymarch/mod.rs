@@ -115,7 +115,7 @@ impl RaymarchRenderer {
     /// Builds the pipeline against the field's bind group layout.
     pub fn new(ctx: &GpuContext, field: &FieldGpu) -> RaymarchRenderer {
         let depth = wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Depth,
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
             view_dimension: wgpu::TextureViewDimension::D2,
             multisampled: false,
         };

@@ -11,7 +11,8 @@ struct March {
 
 @group(1) @binding(0) var<uniform> frame: Frame;
 @group(1) @binding(1) var<uniform> march: March;
-@group(1) @binding(2) var host_depth: texture_depth_2d;
+// The host's depth buffer, bound as unfilterable float (GLSL cannot load from depth samplers).
+@group(1) @binding(2) var host_depth: texture_2d<f32>;
 @group(1) @binding(3) var cloud_out: texture_storage_2d<rgba16float, write>;
 
 // Rays stop once this little light gets through (VolumeCloud's threshold, peers.md).
@@ -185,7 +186,7 @@ fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     let pixel = vec2<f32>(px) + 0.5;
     let o = frame.camera_position.xyz;
     let d = frame_ray_direction(frame, pixel);
-    let depth = textureLoad(host_depth, vec2<i32>(px), 0);
+    let depth = textureLoad(host_depth, vec2<i32>(px), 0).x;
     var t_max = min(frame.camera_position.w, field_ground_distance(o, d, frame.ground_albedo.w > 0.5));
     if depth < 1.0 {
         t_max = min(t_max, frame_depth_distance(frame, pixel, depth));
