@@ -6,6 +6,7 @@
 pub mod export;
 pub mod field;
 pub mod frame;
+mod fsutil;
 pub mod gpu;
 pub mod image;
 pub mod optics;

@@ -8,7 +8,9 @@
 //!   lining) differs.
 //! - A gradient sky becomes a constant sky of the same irradiance on a horizontal surface.
 
-use crate::scene::{PhaseFunction, PhaseModel, Sky, SkyModel};
+use crate::frame::SkyRadiance;
+use crate::optics::PhaseLobes;
+use crate::scene::{PhaseFunction, Scene, SkyModel};
 
 /// One Henyey-Greenstein lobe of a phase-function mixture.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -22,97 +24,45 @@ pub(crate) struct HgLobe {
 /// The scene's phase function as HG lobes whose weights sum to 1 and whose weighted mean cosine is
 /// the scene phase function's.
 ///
+/// The renderer's mixture [`PhaseLobes::from_scene`], `(1 - w_D) HG(g_HG) + w_D Draine(g_D,
+/// alpha)`, keeps its HG lobe; its Draine lobe becomes an HG lobe of the Draine lobe's mean cosine.
+/// Lobes of zero weight are left out, so:
+///
 /// - `hg`: one lobe, exact.
-/// - `dual_hg`: two lobes, exact.
-/// - `mie`: the approximate Mie fit of Jendersie & d'Eon 2023 is `(1 - w_D) HG(g_HG) + w_D
-///   Draine(g_D, alpha)`; its Draine lobe is replaced by an HG lobe of the same mean cosine
-///   ([`draine_mean_cosine`]), which keeps the total mean cosine (0.879 at 20 um).
+/// - `dual_hg`: two lobes, exact (the back lobe is a Draine lobe with `alpha = 0`, which is HG).
+/// - `mie`: the Draine lobe of Jendersie & d'Eon 2023 becomes an HG lobe of the same mean cosine,
+///   which keeps the total mean cosine (0.879 at 20 um).
 pub(crate) fn hg_lobes(phase: &PhaseFunction) -> Vec<HgLobe> {
-    match phase.model {
-        PhaseModel::Hg => vec![HgLobe {
-            weight: 1.0,
-            g: phase.g,
-        }],
-        PhaseModel::DualHg => vec![
-            HgLobe {
-                weight: phase.forward_weight,
-                g: phase.g_forward,
-            },
-            HgLobe {
-                weight: 1.0 - phase.forward_weight,
-                g: phase.g_back,
-            },
-        ],
-        PhaseModel::Mie => {
-            let fit = MieFit::for_diameter_um(phase.droplet_diameter_um);
-            vec![
-                HgLobe {
-                    weight: 1.0 - fit.draine_weight,
-                    g: fit.g_hg,
-                },
-                HgLobe {
-                    weight: fit.draine_weight,
-                    g: draine_mean_cosine(fit.g_draine, fit.alpha),
-                },
-            ]
-        }
-    }
+    let lobes = PhaseLobes::from_scene(phase);
+    let draine_alone = PhaseLobes {
+        w_draine: 1.0,
+        ..lobes
+    };
+    [
+        HgLobe {
+            weight: 1.0 - lobes.w_draine,
+            g: lobes.g_hg,
+        },
+        HgLobe {
+            weight: lobes.w_draine,
+            g: draine_alone.mean_cosine(),
+        },
+    ]
+    .into_iter()
+    .filter(|lobe| lobe.weight > 0.0)
+    .collect()
 }
 
-/// Parameters of the approximate Mie phase function for water droplets (Jendersie & d'Eon 2023,
-/// "An Approximate Mie Scattering Function for Fog and Cloud Rendering", fit for diameters
-/// 5..50 um; numbers in `physics.md`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct MieFit {
-    /// Asymmetry of the HG lobe.
-    pub g_hg: f32,
-    /// Asymmetry parameter of the Draine lobe.
-    pub g_draine: f32,
-    /// Draine's `alpha`.
-    pub alpha: f32,
-    /// Weight of the Draine lobe, `w_D`.
-    pub draine_weight: f32,
-}
-
-impl MieFit {
-    /// The fit at an effective droplet diameter in micrometres.
-    pub(crate) fn for_diameter_um(d: f32) -> MieFit {
-        MieFit {
-            g_hg: (-0.0990567 / (d - 1.67154)).exp(),
-            g_draine: (-2.20679 / (d + 3.91029) - 0.428934).exp(),
-            alpha: (3.62489 - 8.29288 / (d + 5.52825)).exp(),
-            draine_weight: (-0.599085 / (d - 0.641583) - 0.665888).exp(),
-        }
-    }
-}
-
-/// Mean cosine of Draine's phase function `HG(g) (1 + alpha mu^2) / (1 + alpha (1 + 2 g^2) / 3)`
-/// (Draine 2003, "Scattering by Interstellar Dust Grains. I").
-///
-/// From the Legendre moments of HG, `<P_l> = g^l`: `<mu^2>_HG = (1 + 2 g^2) / 3` and
-/// `<mu^3>_HG = g (3 + 2 g^2) / 5`, so `<mu>_D = (g + alpha <mu^3>_HG) / (1 + alpha <mu^2>_HG)`.
-pub(crate) fn draine_mean_cosine(g: f32, alpha: f32) -> f32 {
-    let second_moment = (1.0 + 2.0 * g * g) / 3.0;
-    let third_moment = g * (3.0 + 2.0 * g * g) / 5.0;
-    (g + alpha * third_moment) / (1.0 + alpha * second_moment)
-}
-
-/// Radiance of a constant sky that gives a horizontal surface the same irradiance as `sky`.
-///
-/// The constant sky is itself. The gradient sky is taken as `L(mu) = H + (Z - H) mu^k` over the
-/// upper hemisphere, with `mu` the sine of the elevation, `H` and `Z` the horizon and zenith
-/// radiance and `k` the gradient exponent. Its cosine-weighted mean, `E / pi = 2 integral_0^1
-/// L(mu) mu dmu`, is `H + (Z - H) 2 / (k + 2)`. The lower hemisphere gets the same radiance
-/// (hidden by the ground when there is one).
-pub(crate) fn constant_sky_radiance(sky: &Sky) -> [f32; 3] {
-    match sky.model {
-        SkyModel::Constant => sky.radiance,
+/// Radiance of a constant sky that gives a horizontal surface the same irradiance as the scene's
+/// sky: the cosine-weighted mean of its radiance over the upper hemisphere, `E_up / pi`
+/// ([`SkyRadiance::irradiance_up`]). For the gradient `L = H + (Z - H) sin(elevation)^k` this is
+/// `H + (Z - H) 2 / (k + 2)`. A constant sky keeps its radiance exactly (no round trip through
+/// `pi`). The lower hemisphere gets the same radiance (hidden by the ground when there is one).
+pub(crate) fn constant_sky_radiance(scene: &Scene) -> [f32; 3] {
+    match scene.sky.model {
+        SkyModel::Constant => scene.sky.radiance,
         SkyModel::Gradient => {
-            let zenith_share = 2.0 / (sky.gradient_exponent + 2.0);
-            std::array::from_fn(|c| {
-                let (horizon, zenith) = (sky.horizon_radiance[c], sky.zenith_radiance[c]);
-                horizon + (zenith - horizon) * zenith_share
-            })
+            (SkyRadiance::from_scene(scene).irradiance_up() / std::f32::consts::PI).to_array()
         }
     }
 }
@@ -120,65 +70,78 @@ pub(crate) fn constant_sky_radiance(sky: &Sky) -> [f32; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::optics::draine;
+    use crate::scene::{PhaseModel, Sky};
 
-    /// Midpoint rule over mu in [a, b] with `n` intervals.
+    /// Midpoint rule over [a, b] with `n` intervals.
     fn integrate(a: f64, b: f64, n: usize, f: impl Fn(f64) -> f64) -> f64 {
         let h = (b - a) / n as f64;
         (0..n).map(|i| f(a + (i as f64 + 0.5) * h)).sum::<f64>() * h
     }
 
-    #[test]
-    fn draine_mean_cosine_matches_numerical_integration() {
-        let (g, alpha) = (0.5938f64, 27.1f64);
-        let hg = |mu: f64| (1.0 - g * g) / (1.0 + g * g - 2.0 * g * mu).powf(1.5);
-        let weight = |mu: f64| hg(mu) * (1.0 + alpha * mu * mu);
-        let numeric = integrate(-1.0, 1.0, 200_000, |mu| mu * weight(mu))
-            / integrate(-1.0, 1.0, 200_000, weight);
-        assert!((f64::from(draine_mean_cosine(g as f32, alpha as f32)) - numeric).abs() < 1e-4);
+    fn phase(model: PhaseModel) -> PhaseFunction {
+        PhaseFunction {
+            model,
+            ..Default::default()
+        }
     }
 
     #[test]
     fn mie_lobes_keep_the_published_mean_cosine() {
-        let phase = PhaseFunction {
-            model: PhaseModel::Mie,
-            droplet_diameter_um: 20.0,
-            ..Default::default()
-        };
-        let fit = MieFit::for_diameter_um(20.0);
-        assert!((fit.g_hg - 0.9946).abs() < 1e-4 && (fit.g_draine - 0.5938).abs() < 1e-4);
-        assert!((fit.alpha - 27.1).abs() < 0.05 && (fit.draine_weight - 0.498).abs() < 1e-3);
-        let lobes = hg_lobes(&phase);
+        let lobes = hg_lobes(&phase(PhaseModel::Mie));
+        assert_eq!(lobes.len(), 2);
         let mean_cosine: f32 = lobes.iter().map(|lobe| lobe.weight * lobe.g).sum();
         assert!((mean_cosine - 0.879).abs() < 1e-3, "{mean_cosine}");
         assert!((lobes.iter().map(|lobe| lobe.weight).sum::<f32>() - 1.0).abs() < 1e-6);
     }
 
     #[test]
-    fn dual_hg_lobes_are_the_scene_lobes() {
-        let phase = PhaseFunction {
-            model: PhaseModel::DualHg,
-            ..Default::default()
+    fn mie_draine_lobe_becomes_hg_of_its_mean_cosine() {
+        let mie = PhaseLobes::approximate_mie(20.0);
+        let per_mu = |mu: f64| {
+            2.0 * std::f64::consts::PI * f64::from(draine(mie.g_draine, mie.alpha, mu as f32))
         };
-        let lobes = hg_lobes(&phase);
-        assert_eq!(
-            lobes[0],
-            HgLobe {
-                weight: 0.7,
-                g: 0.8
-            }
+        let numeric = integrate(-1.0, 1.0, 200_000, |mu| mu * per_mu(mu));
+        let replaced = hg_lobes(&phase(PhaseModel::Mie))[1];
+        assert!(
+            (f64::from(replaced.g) - numeric).abs() < 1e-4,
+            "{replaced:?}"
         );
-        assert!((lobes[1].weight - 0.3).abs() < 1e-6 && lobes[1].g == -0.3);
+        assert!((replaced.weight - mie.w_draine).abs() < 1e-7);
     }
 
     #[test]
-    fn gradient_sky_average_matches_numerical_integration() {
-        let sky = Sky {
-            model: SkyModel::Gradient,
-            gradient_exponent: 0.45,
+    fn hg_and_dual_hg_lobes_are_the_scene_lobes() {
+        let single = PhaseFunction {
+            g: 0.85,
+            ..phase(PhaseModel::Hg)
+        };
+        assert_eq!(
+            hg_lobes(&single),
+            [HgLobe {
+                weight: 1.0,
+                g: 0.85
+            }]
+        );
+        let dual = hg_lobes(&phase(PhaseModel::DualHg));
+        assert_eq!(dual.len(), 2);
+        assert!((dual[0].weight - 0.7).abs() < 1e-6 && dual[0].g == 0.8);
+        assert!((dual[1].weight - 0.3).abs() < 1e-6 && dual[1].g == -0.3);
+    }
+
+    #[test]
+    fn gradient_sky_becomes_its_cosine_weighted_mean() {
+        let mut scene = Scene {
+            sky: Sky {
+                model: SkyModel::Gradient,
+                gradient_exponent: 0.45,
+                ..Default::default()
+            },
             ..Default::default()
         };
+        let sky = &scene.sky;
         let k = f64::from(sky.gradient_exponent);
-        let average = constant_sky_radiance(&sky);
+        let average = constant_sky_radiance(&scene);
         let channels = sky
             .horizon_radiance
             .iter()
@@ -189,10 +152,7 @@ mod tests {
             let numeric = 2.0 * integrate(0.0, 1.0, 100_000, |mu| (h + (z - h) * mu.powf(k)) * mu);
             assert!((f64::from(average) - numeric).abs() < 1e-5);
         }
-        let constant = Sky {
-            model: SkyModel::Constant,
-            ..sky
-        };
-        assert_eq!(constant_sky_radiance(&constant), constant.radiance);
+        scene.sky.model = SkyModel::Constant;
+        assert_eq!(constant_sky_radiance(&scene), scene.sky.radiance);
     }
 }

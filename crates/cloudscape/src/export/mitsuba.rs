@@ -26,7 +26,8 @@ use glam::Vec3;
 
 use super::approximations::{HgLobe, constant_sky_radiance, hg_lobes};
 use super::xml::Element;
-use crate::field::voxel::{VoxelError, VoxelGrid, write_atomically};
+use crate::field::voxel::{VoxelError, VoxelGrid};
+use crate::fsutil::write_bytes_atomically;
 use crate::scene::{Camera, Ground, RenderSettings, Scene, Sun};
 
 /// Name of the density grid written beside the scene file.
@@ -89,7 +90,7 @@ pub fn write_mitsuba_scene(
     grid.write_vol(&dir.join(GRID_FILE_NAME))?;
     let scene_path = dir.join(SCENE_FILE_NAME);
     let document = scene_element(scene, grid, extinction_per_m).to_document();
-    write_atomically(&scene_path, document.as_bytes())
+    write_bytes_atomically(&scene_path, document.as_bytes())
         .map_err(|source| io_error(&scene_path, source))?;
     Ok(scene_path)
 }
@@ -130,9 +131,7 @@ fn scene_element(scene: &Scene, grid: &VoxelGrid, extinction_per_m: f32) -> Elem
         .child(plugin("integrator", "volpath").child(integer("max_depth", "$max_depth")))
         .child(sensor(&scene.camera, &scene.render))
         .child(sun_emitter(&scene.sun))
-        .child(
-            plugin("emitter", "constant").child(rgb("radiance", constant_sky_radiance(&scene.sky))),
-        )
+        .child(plugin("emitter", "constant").child(rgb("radiance", constant_sky_radiance(scene))))
         .child(clouds_shape(scene, grid, extinction_per_m))
         .children(ground)
 }
@@ -282,6 +281,7 @@ fn vector(value: Vec3) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fsutil::ScratchDir;
     use crate::scene::{PhaseModel, SkyModel};
 
     fn test_grid() -> VoxelGrid {
@@ -294,12 +294,11 @@ mod tests {
 
     /// Exports `scene` to a temporary directory and returns the grid read back and the XML.
     fn export(name: &str, scene: &Scene) -> (VoxelGrid, String) {
-        let dir =
-            std::env::temp_dir().join(format!("cloudscape-mitsuba-{name}-{}", std::process::id()));
+        let scratch = ScratchDir::new(&format!("mitsuba-{name}"));
+        let dir = scratch.join("scene");
         let path = write_mitsuba_scene(&dir, scene, &test_grid(), 0.06).unwrap();
         let xml = std::fs::read_to_string(&path).unwrap();
         let grid = VoxelGrid::read_vol(&dir.join(GRID_FILE_NAME)).unwrap();
-        std::fs::remove_dir_all(&dir).unwrap();
         (grid, xml)
     }
 
@@ -416,8 +415,8 @@ mod tests {
 
     #[test]
     fn bad_inputs_write_nothing() {
-        let dir =
-            std::env::temp_dir().join(format!("cloudscape-mitsuba-bad-{}", std::process::id()));
+        let scratch = ScratchDir::new("mitsuba-bad");
+        let dir = scratch.join("scene");
         let error =
             write_mitsuba_scene(&dir, &Scene::default(), &test_grid(), f32::NAN).unwrap_err();
         assert!(matches!(error, ExportError::BadExtinction(_)));
@@ -425,6 +424,6 @@ mod tests {
         flat.bbox_max.y = flat.bbox_min.y;
         let error = write_mitsuba_scene(&dir, &Scene::default(), &flat, 0.05).unwrap_err();
         assert!(error.to_string().contains("has no volume"), "{error}");
-        assert!(!dir.exists());
+        assert!(scratch.entries().is_empty());
     }
 }

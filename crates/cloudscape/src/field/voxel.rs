@@ -14,12 +14,12 @@
 //!
 //! A [`VoxelGrid`] holds one channel: reading a multi-channel file keeps channel 0.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{UVec3, Vec3};
 use rayon::prelude::*;
+
+use crate::fsutil::write_bytes_atomically;
 
 /// The bytes every `.vol` file starts with.
 const MAGIC: &[u8; 3] = b"VOL";
@@ -136,7 +136,7 @@ impl VoxelGrid {
                 found: self.values.len(),
             });
         }
-        write_atomically(path, &self.to_vol_bytes()).map_err(|source| io_error(path, source))
+        write_bytes_atomically(path, &self.to_vol_bytes()).map_err(|source| io_error(path, source))
     }
 
     /// A grid whose values are `f` at each cell centre, in metres; evaluated in parallel.
@@ -319,47 +319,24 @@ fn positive<const N: usize>(values: [i32; N]) -> Option<[u32; N]> {
         .then(|| values.map(|v| v as u32))
 }
 
-/// Writes `bytes` to a temporary file beside `path`, then renames it over `path`, so that readers
-/// never see a partial file. The temporary file is removed when writing fails.
-pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    static WRITES: AtomicU64 = AtomicU64::new(0);
-    let unique = WRITES.fetch_add(1, Ordering::Relaxed);
-    let mut temporary_name = path.file_name().unwrap_or_default().to_os_string();
-    temporary_name.push(format!(".{}-{unique}.tmp", std::process::id()));
-    let temporary = path.with_file_name(temporary_name);
-    let result = std::fs::File::create(&temporary)
-        .and_then(|mut file| file.write_all(bytes).and_then(|()| file.sync_all()))
-        .and_then(|()| std::fs::rename(&temporary, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&temporary);
-    }
-    result
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fsutil::ScratchDir;
 
     fn ramp_grid() -> VoxelGrid {
         let (min, max) = (Vec3::new(-100.0, 0.0, 50.0), Vec3::new(100.0, 400.0, 250.0));
         VoxelGrid::from_fn([4, 3, 2], min, max, |p| p.x + 2.0 * p.y - 0.5 * p.z)
     }
 
-    fn temp_dir(name: &str) -> PathBuf {
-        let dir =
-            std::env::temp_dir().join(format!("cloudscape-voxel-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
-    }
-
     #[test]
     fn round_trip_keeps_everything() {
         let grid = ramp_grid();
-        let path = temp_dir("round-trip").join("ramp.vol");
+        let dir = ScratchDir::new("voxel-round-trip");
+        let path = dir.join("ramp.vol");
         grid.write_vol(&path).unwrap();
         assert_eq!(std::fs::metadata(&path).unwrap().len(), 48 + 4 * 24);
         assert_eq!(VoxelGrid::read_vol(&path).unwrap(), grid);
-        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     }
 
     #[test]
@@ -421,7 +398,8 @@ mod tests {
 
     #[test]
     fn truncated_file_is_rejected_with_its_path() {
-        let path = temp_dir("truncated").join("short.vol");
+        let dir = ScratchDir::new("voxel-truncated");
+        let path = dir.join("short.vol");
         let bytes = ramp_grid().to_vol_bytes();
         std::fs::write(&path, &bytes[..bytes.len() - 4]).unwrap();
         let error = VoxelGrid::read_vol(&path).unwrap_err();
@@ -434,7 +412,6 @@ mod tests {
             }
         ));
         assert!(error.to_string().contains("short.vol"));
-        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     }
 
     #[test]
@@ -466,7 +443,8 @@ mod tests {
     fn write_refuses_mismatched_values_and_leaves_no_file() {
         let mut grid = ramp_grid();
         grid.values.pop();
-        let path = temp_dir("mismatch").join("bad.vol");
+        let dir = ScratchDir::new("voxel-mismatch");
+        let path = dir.join("bad.vol");
         assert!(matches!(
             grid.write_vol(&path),
             Err(VoxelError::ValueCount {
@@ -475,7 +453,6 @@ mod tests {
                 ..
             })
         ));
-        assert!(!path.exists());
-        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+        assert!(dir.entries().is_empty());
     }
 }

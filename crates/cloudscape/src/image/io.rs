@@ -4,12 +4,12 @@
 //! directory, which is renamed over the destination only once complete.
 
 use std::fs::File;
-use std::io::BufWriter;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use exr::prelude::{Image, ReadChannels, ReadLayers, SpecificChannels, WritableImage};
 
 use super::{HdrImage, ImageError, LdrImage, check_size};
+use crate::fsutil::write_atomically;
 use crate::post::tonemap::srgb_to_linear;
 use crate::scene::Tonemap;
 
@@ -62,12 +62,16 @@ impl HdrImage {
             (r, g, b, a)
         });
         let image = Image::from_channels((width, self.height as usize), channels);
-        write_atomically(path, |file| {
-            image
-                .write()
-                .to_buffered(file)
-                .map_err(|source| exr_error(path, source))
-        })
+        write_atomically(
+            path,
+            |e| io_error(path, e),
+            |file| {
+                image
+                    .write()
+                    .to_buffered(file)
+                    .map_err(|source| exr_error(path, source))
+            },
+        )
     }
 
     /// Reads an image: OpenEXR as stored (alpha 1 where the file has none), or PNG decoded from
@@ -110,20 +114,24 @@ impl LdrImage {
     pub fn write_png(&self, path: &Path) -> Result<(), ImageError> {
         check_size(self.width, self.height, self.pixels.len())?;
         let bytes: &[u8] = bytemuck::cast_slice(&self.pixels);
-        write_atomically(path, |file| {
-            ::image::write_buffer_with_format(
-                file,
-                bytes,
-                self.width,
-                self.height,
-                ::image::ExtendedColorType::Rgba8,
-                ::image::ImageFormat::Png,
-            )
-            .map_err(|source| ImageError::Png {
-                path: path.to_path_buf(),
-                source,
-            })
-        })
+        write_atomically(
+            path,
+            |e| io_error(path, e),
+            |file| {
+                ::image::write_buffer_with_format(
+                    file,
+                    bytes,
+                    self.width,
+                    self.height,
+                    ::image::ExtendedColorType::Rgba8,
+                    ::image::ImageFormat::Png,
+                )
+                .map_err(|source| ImageError::Png {
+                    path: path.to_path_buf(),
+                    source,
+                })
+            },
+        )
     }
 
     /// Reads a PNG file of any colour type, converted to 8-bit RGBA.
@@ -170,82 +178,10 @@ fn io_error(path: &Path, source: std::io::Error) -> ImageError {
     }
 }
 
-/// A temporary file name beside `path`: hidden, and unique to this process and call.
-fn temporary_path(path: &Path) -> PathBuf {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let unique = COUNTER.fetch_add(1, Ordering::Relaxed);
-    path.with_file_name(format!(".{name}.{}.{unique}.tmp", std::process::id()))
-}
-
-/// Runs `write` on a temporary file beside `path` and renames it to `path` once complete; on any
-/// error the temporary file is removed and `path` is left as it was.
-fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&mut BufWriter<File>) -> Result<(), ImageError>,
-) -> Result<(), ImageError> {
-    let temporary = temporary_path(path);
-    let result = write_and_close(&temporary, path, write)
-        .and_then(|()| std::fs::rename(&temporary, path).map_err(|source| io_error(path, source)));
-    if result.is_err() {
-        // The temporary file is ours and incomplete (or was never created); a failure to remove
-        // it cannot make the outcome worse.
-        let _ = std::fs::remove_file(&temporary);
-    }
-    result
-}
-
-/// Creates `temporary`, runs `write` on it, and flushes, syncs and closes it (a file must be
-/// closed before it is renamed on some systems). Errors name `path`, the file the user asked for.
-fn write_and_close(
-    temporary: &Path,
-    path: &Path,
-    write: impl FnOnce(&mut BufWriter<File>) -> Result<(), ImageError>,
-) -> Result<(), ImageError> {
-    let file = File::create(temporary).map_err(|source| io_error(path, source))?;
-    let mut writer = BufWriter::new(file);
-    write(&mut writer)?;
-    let file = writer
-        .into_inner()
-        .map_err(|e| io_error(path, e.into_error()))?;
-    file.sync_all().map_err(|source| io_error(path, source))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A scratch directory, removed when dropped.
-    struct ScratchDir(PathBuf);
-
-    impl ScratchDir {
-        fn new(name: &str) -> Self {
-            let dir = std::env::temp_dir()
-                .join(format!("cloudscape-image-{name}-{}", std::process::id()));
-            let _ = std::fs::remove_dir_all(&dir);
-            std::fs::create_dir_all(&dir).expect("create scratch dir");
-            ScratchDir(dir)
-        }
-
-        fn entries(&self) -> Vec<String> {
-            let mut names: Vec<String> = std::fs::read_dir(&self.0)
-                .expect("list scratch dir")
-                .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-                .collect();
-            names.sort();
-            names
-        }
-    }
-
-    impl Drop for ScratchDir {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
+    use crate::fsutil::ScratchDir;
 
     fn hdr_sample() -> HdrImage {
         let pixels = (0..12u8)
@@ -274,8 +210,8 @@ mod tests {
 
     #[test]
     fn exr_round_trip_is_exact() {
-        let dir = ScratchDir::new("exr");
-        let path = dir.0.join("frame.exr");
+        let dir = ScratchDir::new("image-exr");
+        let path = dir.join("frame.exr");
         hdr_sample().write_exr(&path).expect("write exr");
         assert_eq!(HdrImage::read(&path).expect("read exr"), hdr_sample());
         assert_eq!(dir.entries(), ["frame.exr"]);
@@ -283,8 +219,8 @@ mod tests {
 
     #[test]
     fn png_round_trip_is_exact() {
-        let dir = ScratchDir::new("png");
-        let path = dir.0.join("frame.PNG");
+        let dir = ScratchDir::new("image-png");
+        let path = dir.join("frame.PNG");
         ldr_sample().write_png(&path).expect("write png");
         assert_eq!(LdrImage::read_png(&path).expect("read png"), ldr_sample());
         // Read as HDR, the same file decodes from sRGB to linear.
@@ -297,14 +233,14 @@ mod tests {
 
     #[test]
     fn write_image_picks_format_by_extension() {
-        let dir = ScratchDir::new("by-ext");
+        let dir = ScratchDir::new("image-by-ext");
         let hdr = hdr_sample();
-        write_image(&dir.0.join("a.exr"), &hdr, 0.0, Tonemap::Aces).expect("exr");
-        write_image(&dir.0.join("b.png"), &hdr, -3.0, Tonemap::Agx).expect("png");
-        assert_eq!(HdrImage::read(&dir.0.join("a.exr")).expect("read exr"), hdr);
-        let png = LdrImage::read_png(&dir.0.join("b.png")).expect("read png");
+        write_image(&dir.join("a.exr"), &hdr, 0.0, Tonemap::Aces).expect("exr");
+        write_image(&dir.join("b.png"), &hdr, -3.0, Tonemap::Agx).expect("png");
+        assert_eq!(HdrImage::read(&dir.join("a.exr")).expect("read exr"), hdr);
+        let png = LdrImage::read_png(&dir.join("b.png")).expect("read png");
         assert_eq!(png, hdr.to_ldr(-3.0, Tonemap::Agx));
-        let err = write_image(&dir.0.join("c.jpg"), &hdr, 0.0, Tonemap::Aces).expect_err("jpg");
+        let err = write_image(&dir.join("c.jpg"), &hdr, 0.0, Tonemap::Aces).expect_err("jpg");
         assert!(matches!(err, ImageError::UnsupportedFormat { .. }));
         assert!(err.to_string().contains("c.jpg"), "{err}");
         assert_eq!(dir.entries(), ["a.exr", "b.png"]);
@@ -312,8 +248,8 @@ mod tests {
 
     #[test]
     fn unwritable_path_is_an_error_and_leaves_nothing() {
-        let dir = ScratchDir::new("unwritable");
-        let missing = dir.0.join("no-such-dir").join("out.png");
+        let dir = ScratchDir::new("image-unwritable");
+        let missing = dir.join("no-such-dir").join("out.png");
         let err = ldr_sample()
             .write_png(&missing)
             .expect_err("missing directory");
@@ -321,7 +257,7 @@ mod tests {
         assert!(err.to_string().contains("out.png"), "{err}");
         // The destination is a directory: the temporary file is written, the rename fails, and
         // the temporary file is removed again.
-        let occupied = dir.0.join("taken.exr");
+        let occupied = dir.join("taken.exr");
         std::fs::create_dir(&occupied).expect("create dir");
         let err = hdr_sample()
             .write_exr(&occupied)
@@ -332,14 +268,14 @@ mod tests {
 
     #[test]
     fn inconsistent_image_is_not_written() {
-        let dir = ScratchDir::new("bad-size");
+        let dir = ScratchDir::new("image-bad-size");
         let bad = HdrImage {
             width: 3,
             height: 3,
             pixels: vec![[0.0; 4]; 4],
         };
         let err = bad
-            .write_exr(&dir.0.join("bad.exr"))
+            .write_exr(&dir.join("bad.exr"))
             .expect_err("9 pixels declared, 4 given");
         assert!(matches!(err, ImageError::BadSize { len: 4, .. }));
         assert!(dir.entries().is_empty());
@@ -347,14 +283,14 @@ mod tests {
 
     #[test]
     fn reading_garbage_names_the_file() {
-        let dir = ScratchDir::new("garbage");
+        let dir = ScratchDir::new("image-garbage");
         for name in ["junk.png", "junk.exr"] {
-            let path = dir.0.join(name);
+            let path = dir.join(name);
             std::fs::write(&path, b"not an image").expect("write junk");
             let err = HdrImage::read(&path).expect_err("garbage");
             assert!(err.to_string().contains(name), "{err}");
         }
-        let err = HdrImage::read(&dir.0.join("missing.exr")).expect_err("missing");
+        let err = HdrImage::read(&dir.join("missing.exr")).expect_err("missing");
         assert!(err.to_string().contains("missing.exr"), "{err}");
     }
 }

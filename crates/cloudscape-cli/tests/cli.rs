@@ -1,0 +1,244 @@
+//! End-to-end tests of the `cloudscape` binary: each runs the real executable in a fresh scratch
+//! directory and checks its exit status, its messages and the files it writes (or must not write).
+//!
+//! GPU work stays tiny (64x36 pixels, low quality). Like the library's GPU tests, these honour
+//! `CLOUDSCAPE_TEST_BACKEND` (`vulkan` or `gl`) and fail, never skip, when no adapter exists.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use cloudscape::field::VoxelGrid;
+use cloudscape::gpu::context::TEST_BACKEND_ENV;
+use cloudscape::image::{HdrImage, LdrImage};
+
+/// Arguments that keep a render small and fast.
+const TINY: [&str; 6] = [
+    "--width",
+    "64",
+    "--height",
+    "36",
+    "--set",
+    "render.quality=low",
+];
+
+/// A scratch directory unique to one test of this process, removed when dropped.
+struct Scratch(PathBuf);
+
+impl Scratch {
+    /// An empty directory `cloudscape-cli-{test}-{process id}` in the system's temporary directory.
+    fn new(test: &str) -> Scratch {
+        let dir =
+            std::env::temp_dir().join(format!("cloudscape-cli-{test}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("create scratch dir");
+        Scratch(dir)
+    }
+
+    /// The path of `name` inside the directory.
+    fn join(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+
+    /// The names of the files and directories in the directory.
+    fn file_names(&self) -> BTreeSet<String> {
+        let entries = std::fs::read_dir(&self.0).expect("list scratch dir");
+        entries
+            .map(|entry| entry.expect("read scratch dir entry").file_name())
+            .map(|name| name.to_string_lossy().into_owned())
+            .collect()
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// What one run of the binary did.
+struct Run {
+    success: bool,
+    stdout: String,
+    stderr: String,
+}
+
+/// Runs `cloudscape args...` in `dir`, with `--backend` from `CLOUDSCAPE_TEST_BACKEND` when set
+/// and `gpu` is true (only `render` and `bench` take it).
+fn cloudscape(dir: &Path, args: &[&str], gpu: bool) -> Run {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_cloudscape"));
+    command.current_dir(dir).args(args);
+    if let Some(backend) = std::env::var_os(TEST_BACKEND_ENV).filter(|_| gpu) {
+        command.arg("--backend").arg(backend);
+    }
+    let output = command.output().expect("start the cloudscape binary");
+    Run {
+        success: output.status.success(),
+        stdout: String::from_utf8_lossy(&output.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&output.stderr).into_owned(),
+    }
+}
+
+/// `cloudscape render [scene] TINY --out out`.
+fn render(dir: &Path, scene: Option<&str>, out: &str) -> Run {
+    let mut args = vec!["render"];
+    args.extend(scene);
+    args.extend(TINY);
+    args.extend(["--out", out]);
+    cloudscape(dir, &args, true)
+}
+
+/// Asserts that `run` failed, that its error message holds every piece of `expected`, and that
+/// the scratch directory holds exactly the files named in `before`.
+fn assert_rejected(scratch: &Scratch, before: &[&str], run: &Run, expected: &[&str]) {
+    assert!(!run.success, "should fail; stderr:\n{}", run.stderr);
+    for piece in expected {
+        assert!(
+            run.stderr.contains(piece),
+            "{piece:?} missing from:\n{}",
+            run.stderr
+        );
+    }
+    let before: BTreeSet<String> = before.iter().map(|name| name.to_string()).collect();
+    assert_eq!(scratch.file_names(), before, "a rejected run wrote a file");
+}
+
+/// Renders the scene file `toml` (as `scene.toml`) and asserts that it is rejected with every
+/// piece of `expected` in the message and no file written.
+fn assert_scene_rejected(test: &str, toml: &str, expected: &[&str]) {
+    let scratch = Scratch::new(test);
+    std::fs::write(scratch.join("scene.toml"), toml).expect("write scene file");
+    let run = render(&scratch.0, Some("scene.toml"), "out.png");
+    assert_rejected(&scratch, &["scene.toml"], &run, expected);
+}
+
+/// Runs `cloudscape args...` in an empty directory and asserts that it is rejected with every
+/// piece of `expected` in the message and no file written.
+fn assert_args_rejected(test: &str, args: &[&str], gpu: bool, expected: &[&str]) {
+    let scratch = Scratch::new(test);
+    let run = cloudscape(&scratch.0, args, gpu);
+    assert_rejected(&scratch, &[], &run, expected);
+}
+
+#[test]
+fn render_writes_a_png_of_the_requested_size() {
+    let scratch = Scratch::new("render-png");
+    let run = render(&scratch.0, None, "out.png");
+    assert!(run.success, "{}", run.stderr);
+    assert!(run.stderr.contains("adapter: "), "{}", run.stderr);
+    assert!(run.stderr.contains("wrote out.png"), "{}", run.stderr);
+    let png = LdrImage::read_png(&scratch.join("out.png")).expect("read the PNG");
+    assert_eq!((png.width, png.height), (64, 36));
+    assert!(
+        png.pixels.iter().any(|p| *p != png.pixels[0]),
+        "the image is one flat colour"
+    );
+}
+
+#[test]
+fn render_exr_holds_finite_non_negative_radiance() {
+    let scratch = Scratch::new("render-exr");
+    let run = render(&scratch.0, None, "out.exr");
+    assert!(run.success, "{}", run.stderr);
+    let hdr = HdrImage::read(&scratch.join("out.exr")).expect("read the EXR");
+    assert_eq!((hdr.width, hdr.height), (64, 36));
+    let radiance = hdr.pixels.iter().flat_map(|p| &p[..3]);
+    assert!(radiance.clone().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(hdr.mean_luminance() > 0.0, "the image is black");
+}
+
+#[test]
+fn coverage_out_of_range_is_located_in_the_file() {
+    let expected = ["scene.toml:2:12", "layers.0.coverage", "allowed 0..1"];
+    assert_scene_rejected("coverage", "[[layers]]\ncoverage = 1.5\n", &expected);
+}
+
+#[test]
+fn unknown_key_is_located_and_the_known_keys_listed() {
+    let expected = ["scene.toml:2:1", "unknown field `widht`", "`width`"];
+    assert_scene_rejected("unknown-key", "[render]\nwidht = 64\n", &expected);
+}
+
+#[test]
+fn missing_weather_map_is_located_and_named() {
+    let toml = "[weather]\nsource = \"file\"\npath = \"nope.png\"\n";
+    let expected = ["scene.toml:3:8", "weather.path", "nope.png"];
+    assert_scene_rejected("weather", toml, &expected);
+}
+
+#[test]
+fn missing_volume_file_is_located_and_named() {
+    let toml = "[[volumes]]\npath = \"missing.vol\"\n";
+    let expected = ["scene.toml:2:8", "volumes.0.path", "missing.vol"];
+    assert_scene_rejected("volume", toml, &expected);
+}
+
+#[test]
+fn zero_width_is_rejected_with_the_allowed_range() {
+    let args = ["render", "--width", "0", "--out", "out.png"];
+    let expected = ["--set render.width=0", "render.width", "allowed >= 1"];
+    assert_args_rejected("width-zero", &args, true, &expected);
+}
+
+#[test]
+fn width_above_the_adapters_texture_limit_says_so() {
+    let args = ["render", "--width", "100000", "--out", "out.png"];
+    let expected = ["render.width", "maximum texture size", "allowed 1.."];
+    assert_args_rejected("width-huge", &args, true, &expected);
+}
+
+/// Metal exists only on Apple systems.
+#[cfg(not(target_vendor = "apple"))]
+#[test]
+fn missing_backend_says_what_to_install() {
+    let args = ["render", "--backend", "metal", "--out", "out.png"];
+    let expected = ["no adapter found on backend metal", "apt-get install"];
+    assert_args_rejected("metal", &args, false, &expected);
+}
+
+#[test]
+fn export_writes_a_mitsuba_scene_and_a_readable_grid() {
+    let scratch = Scratch::new("export");
+    let args = ["export", "--resolution", "16", "--out", "mitsuba"];
+    let run = cloudscape(&scratch.0, &args, false);
+    assert!(run.success, "{}", run.stderr);
+    let xml = std::fs::read_to_string(scratch.join("mitsuba/scene.xml")).expect("read scene.xml");
+    assert!(
+        xml.contains("<string name=\"filename\" value=\"clouds.vol\"/>"),
+        "{xml}"
+    );
+    let grid = VoxelGrid::read_vol(&scratch.join("mitsuba/clouds.vol")).expect("read clouds.vol");
+    assert_eq!(grid.resolution.into_iter().max(), Some(16));
+    assert!(grid.max_value() > 0.0, "the exported grid is empty");
+}
+
+#[test]
+fn bench_json_reports_each_pass_and_the_frame_wall_time() {
+    let scratch = Scratch::new("bench");
+    let mut args = vec!["bench", "--frames", "2", "--warmup", "0", "--json"];
+    args.extend(TINY);
+    let run = cloudscape(&scratch.0, &args, true);
+    assert!(run.success, "{}", run.stderr);
+    let report: serde_json::Value = serde_json::from_str(&run.stdout).expect("JSON on stdout");
+    assert_eq!(report["frames"], 2);
+    assert_eq!(
+        (report["width"].as_u64(), report["height"].as_u64()),
+        (Some(64), Some(36))
+    );
+    let passes: Vec<&str> = report["passes"]
+        .as_array()
+        .expect("a passes array")
+        .iter()
+        .filter_map(|pass| pass["name"].as_str())
+        .collect();
+    let expected: &[&str] = match report["timestamps"].as_bool() {
+        Some(true) => &["raymarch", "compose", "display"],
+        _ => &[],
+    };
+    assert_eq!(passes, expected);
+    let wall_ms = report["frame_wall"]["mean_ms"]
+        .as_f64()
+        .expect("frame_wall.mean_ms");
+    assert!(wall_ms > 0.0, "{report}");
+    assert!(scratch.file_names().is_empty(), "bench wrote a file");
+}
