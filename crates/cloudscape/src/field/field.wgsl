@@ -100,7 +100,7 @@ fn field_height_gradient(type_coord: f32, f: f32) -> f32 {
     var gradients = array<vec4<f32>, 4>(
         vec4<f32>(0.0, 0.07, 0.08, 0.15),
         vec4<f32>(0.0, 0.2, 0.42, 0.6),
-        vec4<f32>(0.0, 0.08, 0.75, 1.0),
+        vec4<f32>(0.0, 0.1, 0.2, 1.0),
         vec4<f32>(0.0, 0.05, 0.9, 1.0),
     );
     let g = gradients[lo] * (1.0 - w) + gradients[lo + 1u] * w;

@@ -343,8 +343,8 @@ impl Default for NoiseSettings {
         NoiseSettings {
             seed: 3,
             base_period_m: 9000.0,
-            detail_period_m: 1200.0,
-            detail_erosion: 0.35,
+            detail_period_m: 700.0,
+            detail_erosion: 0.4,
             curl_displacement_m: 120.0,
         }
     }
