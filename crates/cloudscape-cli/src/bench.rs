@@ -56,6 +56,8 @@ struct Report {
     height: u32,
     frames: u32,
     timestamps: bool,
+    /// A CPU (software) adapter, whose timestamp queries do not measure shader execution.
+    software: bool,
     passes: Vec<Stat>,
     frame_wall: Stat,
 }
@@ -88,6 +90,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         height: frame.size.y,
         frames: args.frames,
         timestamps: ctx.has_timestamps(),
+        software: ctx.adapter_info().device_type == wgpu::DeviceType::Cpu,
         passes: PASSES
             .iter()
             .zip(pass_ms)
@@ -110,6 +113,10 @@ fn print_report(report: &Report, json: bool) -> Result<()> {
     );
     if !report.timestamps {
         println!("(this adapter has no timestamp queries: GPU time per pass is not available)");
+    } else if report.software {
+        println!(
+            "(a software adapter: its timestamps do not time shader execution; trust the wall time)"
+        );
     }
     println!(
         "{:<14} {:>10} {:>10} {:>10}",

@@ -134,7 +134,7 @@ fn field_erode(density: f32, detail: vec4<f32>, f: f32, erosion: f32) -> f32 {
     return clamp(field_remap(density, modifier * erosion, 1.0, 0.0, 1.0), 0.0, 1.0);
 }
 
-fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32) -> f32 {
+fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32, eroded: bool) -> f32 {
     let f = (h - layer.shape.x) / layer.shape.y;
     if f < 0.0 || f > 1.0 {
         return 0.0;
@@ -159,6 +159,9 @@ fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32) -> f32 {
     if covered <= 0.0 {
         return 0.0;
     }
+    if !eroded {
+        return min(covered, 1.0) * w.z * layer.shape.w;
+    }
     let curl = textureSampleLevel(field_curl_noise, field_repeat_linear, q.xz / field.noise.x, 0.0);
     let swirl = (curl.xy * 2.0 - 1.0) * field.noise.w * (1.0 - f);
     let detail = textureSampleLevel(field_detail_noise, field_repeat_linear, (q + vec3<f32>(swirl.x, 0.0, swirl.y)) / field.noise.y, 0.0);
@@ -175,15 +178,24 @@ fn field_volume_extinction(v: FieldVolume, p: vec3<f32>) -> f32 {
     return textureSampleLevel(field_volume_atlas, field_clamp_linear, atlas_uvw, 0.0).x * v.min_m.w;
 }
 
-// Extinction sigma_t (m^-1) at world point p (m) at the field's time: CloudField::extinction_per_m.
-fn field_extinction(p: vec3<f32>) -> f32 {
+fn field_extinction_detail(p: vec3<f32>, eroded: bool) -> f32 {
     let h = field_altitude_m(p);
     var sigma_t = 0.0;
     for (var i = 0u; i < field.counts.x; i++) {
-        sigma_t += field_layer_extinction(field.layers[i], p, h);
+        sigma_t += field_layer_extinction(field.layers[i], p, h, eroded);
     }
     for (var i = 0u; i < field.counts.y; i++) {
         sigma_t += field_volume_extinction(field.volumes[i], p);
     }
     return sigma_t;
+}
+
+// Extinction sigma_t (m^-1) at world point p (m) at the field's time: CloudField::extinction_per_m.
+fn field_extinction(p: vec3<f32>) -> f32 {
+    return field_extinction_detail(p, true);
+}
+
+// The same without detail erosion: CloudField::coarse_extinction_per_m.
+fn field_extinction_coarse(p: vec3<f32>) -> f32 {
+    return field_extinction_detail(p, false);
 }

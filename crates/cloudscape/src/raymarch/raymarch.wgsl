@@ -57,7 +57,8 @@ fn march_volume_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
     return hull;
 }
 
-// Optical depth toward the sun from p: `light_steps` segments whose lengths double, covering the way
+// Optical depth toward the sun from p, through the coarse (uneroded) density as Schneider 2015's
+// cheap light samples: `light_steps` segments whose lengths double, covering the way
 // to the top of the layers (at most MARCH_SUN_PATH_MAX_M), each sampled at a jittered point (VolumeCloud samples the
 // sun path at 0.5, 1.5, 3, 6, 12 units with weights 1, 1, 2, 4, 8; peers.md).
 fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
@@ -73,7 +74,7 @@ fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
     for (var k = 0u; k < n; k++) {
         let width = unit * f32(1u << k);
         let offset = fract(jitter + f32(k + 1u) * 0.618034); // decorrelated from the view jitter
-        tau += field_extinction(p + sun * (start + width * offset)) * width;
+        tau += field_extinction_coarse(p + sun * (start + width * offset)) * width;
         start += width;
     }
     return tau;
@@ -99,8 +100,8 @@ fn march_ambient(p: vec3<f32>, h: f32) -> vec3<f32> {
         above = field.planet.w - h;
         below = h - field.planet.z;
     }
-    let tau_up = field_extinction(p + up * (0.5 * above)) * above;
-    let tau_down = field_extinction(p - up * (0.5 * below)) * below;
+    let tau_up = field_extinction_coarse(p + up * (0.5 * above)) * above;
+    let tau_down = field_extinction_coarse(p - up * (0.5 * below)) * below;
     var ground = frame.ground_radiance.xyz;
     if frame.ground_albedo.w < 0.5 {
         ground = frame.sky_horizon.xyz;
