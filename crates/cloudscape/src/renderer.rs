@@ -9,7 +9,7 @@ use crate::gpu::timing::PassTimer;
 use crate::gpu::{GpuContext, readback};
 use crate::image::{HdrImage, LdrImage};
 use crate::post::{Background, DISPLAY_FORMAT, Display, HDR_FORMAT};
-use crate::raymarch::{CLOUD_FORMAT, MarchSettings, RaymarchRenderer, RaymarchTargets};
+use crate::raymarch::{CLOUD_FORMAT, MarchSettings, MarchStats, RaymarchRenderer, RaymarchTargets};
 use crate::scene::Scene;
 use glam::UVec2;
 use std::path::Path;
@@ -129,6 +129,11 @@ impl SceneRenderer {
     /// The CPU field this renderer draws (the specification the GPU follows).
     pub fn field(&self) -> &CloudField {
         &self.field
+    }
+
+    /// What the ray marcher counted during the last render.
+    pub fn march_stats(&self, ctx: &GpuContext) -> MarchStats {
+        self.raymarch.stats(ctx)
     }
 
     /// The field's GPU resources.

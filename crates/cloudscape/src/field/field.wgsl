@@ -20,10 +20,11 @@ struct Field {
     planet: vec4<f32>,     // radius_m, 1 if flat, lowest layer bottom_m, highest layer top_m
     noise: vec4<f32>,      // base period m, detail period m, detail erosion, curl displacement m
     weather: vec4<f32>,    // weather extent x, z (m), time_s
-    counts: vec4<u32>,     // layer count, volume count
+    counts: vec4<u32>,     // layer count, volume count, hi-height level count
     atlas_size: vec4<f32>, // atlas texels xyz
     layers: array<FieldLayer, 4>,
     volumes: array<FieldVolume, 4>,
+    hiheight_levels: array<vec4<u32>, 16>, // per level: first cell, width, height
 }
 
 @group(0) @binding(0) var<uniform> field: Field;
@@ -34,6 +35,8 @@ struct Field {
 @group(0) @binding(5) var field_volume_atlas: texture_3d<f32>;
 @group(0) @binding(6) var field_repeat_linear: sampler;
 @group(0) @binding(7) var field_clamp_linear: sampler;
+// Hi-height pyramid cells, all levels back to back: per-layer highest cloud altitude (m).
+@group(0) @binding(8) var<storage, read> field_hiheight: array<vec4<f32>>;
 
 const FIELD_NO_HIT: f32 = 3.0e38;
 

@@ -6,6 +6,7 @@
 //! Perlin-Worley base shape and Worley detail erosion, with curl noise displacing the detail.
 
 pub mod gpu;
+pub mod hiheight;
 mod layer;
 pub mod noise;
 pub mod profile;

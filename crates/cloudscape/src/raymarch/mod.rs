@@ -49,6 +49,8 @@ pub struct MarchSettings {
     pub ambient_scale: f32,
     /// Phase function.
     pub phase: PhaseLobes,
+    /// Skip empty space above the clouds with the hi-height pyramid (the image does not change).
+    pub empty_space_skipping: bool,
 }
 
 impl MarchSettings {
@@ -80,6 +82,7 @@ impl MarchSettings {
             albedo: l.albedo,
             ambient_scale: l.ambient_scale,
             phase: PhaseLobes::from_scene(&scene.phase),
+            empty_space_skipping: r.empty_space_skipping,
         }
     }
 }
@@ -92,6 +95,16 @@ struct MarchUniform {
     phase: Vec4,
     ambient: Vec4,
     tile: UVec4,
+    flags: UVec4,
+}
+
+/// What the march did, counted on the GPU since the last [`RaymarchRenderer::prepare`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MarchStats {
+    /// Pixels marched.
+    pub pixels: u32,
+    /// Extinction evaluations along view rays, per marched pixel.
+    pub density_samples_per_pixel: f64,
 }
 
 /// Where the march reads and writes.
@@ -108,8 +121,16 @@ pub struct RaymarchRenderer {
     layout: wgpu::BindGroupLayout,
     frame: wgpu::Buffer,
     march: wgpu::Buffer,
+    stats: wgpu::Buffer,
     settings: MarchUniform,
 }
+
+/// The counters' binding: a read-write storage buffer.
+const STATS: wgpu::BindingType = wgpu::BindingType::Buffer {
+    ty: wgpu::BufferBindingType::Storage { read_only: false },
+    has_dynamic_offset: false,
+    min_binding_size: None,
+};
 
 impl RaymarchRenderer {
     /// Builds the pipeline against the field's bind group layout.
@@ -122,7 +143,13 @@ impl RaymarchRenderer {
         let layout = bind_group_layout(
             &ctx.device,
             "raymarch",
-            &[UNIFORM, UNIFORM, depth, storage_texture_2d(CLOUD_FORMAT)],
+            &[
+                UNIFORM,
+                UNIFORM,
+                depth,
+                storage_texture_2d(CLOUD_FORMAT),
+                STATS,
+            ],
         );
         let pipeline = compute_pipeline(
             ctx,
@@ -147,7 +174,25 @@ impl RaymarchRenderer {
                 size_of::<crate::frame::FrameUniform>() as u64,
             ),
             march: buffer("raymarch settings", size_of::<MarchUniform>() as u64),
+            stats: ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("raymarch stats"),
+                size: 8,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
             settings: MarchUniform::zeroed(),
+        }
+    }
+
+    /// Reads back the counters of the work submitted since the last `prepare` (waits for it).
+    pub fn stats(&self, ctx: &GpuContext) -> MarchStats {
+        let counts = crate::gpu::read_buffer::<u32>(ctx, &self.stats);
+        let (samples, pixels) = (counts[0], counts[1]);
+        MarchStats {
+            pixels,
+            density_samples_per_pixel: samples as f64 / pixels.max(1) as f64,
         }
     }
 
@@ -170,7 +215,10 @@ impl RaymarchRenderer {
                 0.0,
             ),
             tile: UVec4::ZERO,
+            flags: UVec4::new(settings.empty_space_skipping as u32, 0, 0, 0),
         };
+        ctx.queue
+            .write_buffer(&self.stats, 0, bytemuck::bytes_of(&[0u32; 2]));
         ctx.queue
             .write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame.uniform()));
         ctx.queue
@@ -202,6 +250,7 @@ impl RaymarchRenderer {
                 self.march.as_entire_binding(),
                 wgpu::BindingResource::TextureView(targets.depth),
                 wgpu::BindingResource::TextureView(targets.clouds),
+                self.stats.as_entire_binding(),
             ],
         );
         dispatch_2d(

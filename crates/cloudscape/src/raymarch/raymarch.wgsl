@@ -6,7 +6,14 @@ struct March {
     octaves: vec4<f32>, // attenuation a, contribution b, eccentricity c, single-scattering albedo
     phase: vec4<f32>,   // phase lobes (optics::PhaseLobes::to_gpu)
     ambient: vec4<f32>, // ambient scale, phase mean cosine g
-    tile: vec4<u32>,    // origin of the pixel tile this dispatch covers
+        tile: vec4<u32>,    // origin of the pixel tile this dispatch covers
+    flags: vec4<u32>,   // 1 to skip empty space with the hi-height pyramid
+}
+
+struct MarchResult {
+    radiance: vec3<f32>,
+    transmittance: f32,
+    density_samples: u32, // view-ray extinction evaluations
 }
 
 @group(1) @binding(0) var<uniform> frame: Frame;
@@ -14,6 +21,8 @@ struct March {
 // The host's depth buffer, bound as unfilterable float (GLSL cannot load from depth samplers).
 @group(1) @binding(2) var host_depth: texture_2d<f32>;
 @group(1) @binding(3) var cloud_out: texture_storage_2d<rgba16float, write>;
+// Counters over the dispatch: [0] view-ray density samples, [1] pixels marched.
+@group(1) @binding(4) var<storage, read_write> march_stats: array<atomic<u32>, 2>;
 
 // Rays stop once this little light gets through (VolumeCloud's threshold, peers.md).
 const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
@@ -144,19 +153,33 @@ fn march_step_count(length_m: f32) -> u32 {
 // Integrates [t0, t1] in `march_step_count` strata, one sample per stratum at fraction `jitter` of it,
 // with Hillaire 2016's energy-conserving step: S_int = (S - S exp(-sigma_t dt)) / sigma_t;
 // L += T S_int; T *= exp(-sigma_t dt).
-fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32) -> vec4<f32> {
+// `volume` is the stretch inside voxel-grid boxes, which the hi-height pyramid does not describe.
+fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volume: vec2<f32>) -> MarchResult {
     let n = march_step_count(t1 - t0);
     let cos_theta = dot(d, frame.sun_direction.xyz);
     let albedo = march.octaves.w;
     var radiance = vec3<f32>(0.0);
     var transmittance = 1.0;
-    var depth_weighted = 0.0;
+        var depth_weighted = 0.0;
+    var samples = 0u;
+    var skip = vec2<f32>(t0, t0); // (empty until, query again at) from field_empty_until
+    let skipping = march.flags.x == 1u && field.counts.z > 0u;
     var t_start = t0;
     for (var i = 0u; i < n; i++) {
         let t_end = march_stratum_t(t0, t1, f32(i + 1u) / f32(n));
         let dt = t_end - t_start;
-        let p = o + d * (t_start + jitter * dt);
+                let t = t_start + jitter * dt;
+        let p = o + d * t;
         t_start = t_end;
+        if skipping && (t < volume.x || t > volume.y) {
+            if t >= skip.y {
+                skip = field_empty_until(o, d, t, t1);
+            }
+            if t < skip.x {
+                continue;
+            }
+        }
+        samples += 1u;
         let sigma_t = field_extinction(p);
         if sigma_t <= 0.0 {
             continue;
@@ -175,7 +198,7 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32) -> v
     // Aerial perspective at the transmittance-weighted mean cloud depth (Hillaire 2016, 5.9.1).
     let coverage = 1.0 - transmittance;
     let depth = select(0.0, depth_weighted / coverage, coverage > 0.0);
-    return vec4<f32>(frame_haze(frame, radiance, coverage, depth), transmittance);
+        return MarchResult(frame_haze(frame, radiance, coverage, depth), transmittance, samples);
 }
 
 @compute @workgroup_size(8, 8)
@@ -201,11 +224,16 @@ fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
         // Samples of one pixel are stratified: offsets s / spp from one per-pixel jitter.
         let spp = march.counts.z;
         let pixel_jitter = frame_pixel_jitter(px, u32(frame.viewport.w));
-        var sum = vec4<f32>(0.0);
+                var sum = vec4<f32>(0.0);
+        var samples = 0u;
         for (var s = 0u; s < spp; s++) {
-            sum += march_segment(o, d, t0, t1, fract(pixel_jitter + f32(s) / f32(spp)));
+            let m = march_segment(o, d, t0, t1, fract(pixel_jitter + f32(s) / f32(spp)), volume);
+            sum += vec4<f32>(m.radiance, m.transmittance);
+            samples += m.density_samples;
         }
         result = sum / f32(spp);
+        atomicAdd(&march_stats[0], samples);
     }
+        atomicAdd(&march_stats[1], 1u);
     textureStore(cloud_out, vec2<i32>(px), result);
 }

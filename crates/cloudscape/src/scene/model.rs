@@ -499,6 +499,8 @@ pub struct RenderSettings {
     pub light_steps: Option<u32>,
     /// Overrides the preset's jittered passes averaged per pixel, 1..1024.
     pub samples_per_pixel: Option<u32>,
+    /// Skip the empty space above the clouds with the hierarchical height map (same image, less work).
+    pub empty_space_skipping: bool,
     /// Exposure in stops (EV) applied before tone mapping, -20..20.
     pub exposure_ev: f32,
     /// Tone-mapping operator for PNG output.
@@ -519,6 +521,7 @@ impl Default for RenderSettings {
             primary_steps: None,
             light_steps: None,
             samples_per_pixel: None,
+            empty_space_skipping: true,
             exposure_ev: 0.0,
             tonemap: Tonemap::Aces,
             time_s: 0.0,
