@@ -60,6 +60,8 @@ struct Report {
     software: bool,
     passes: Vec<Stat>,
     frame_wall: Stat,
+    /// Extinction evaluations along view rays per pixel (the last frame).
+    density_samples_per_pixel: f64,
 }
 
 /// Renders the scene's frame repeatedly, with the jitter advancing, and reports timings.
@@ -98,6 +100,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             .map(|(n, s)| Stat::new(n, s))
             .collect(),
         frame_wall: Stat::new("frame (wall)", wall_ms),
+        density_samples_per_pixel: renderer.march_stats(&ctx).density_samples_per_pixel,
     };
     print_report(&report, args.json)
 }
@@ -128,5 +131,7 @@ fn print_report(report: &Report, json: bool) -> Result<()> {
             s.name, s.mean_ms, s.median_ms, s.min_ms
         );
     }
+    let samples = report.density_samples_per_pixel;
+    println!("view-ray density samples per pixel: {samples:.1}");
     Ok(())
 }
