@@ -5,7 +5,8 @@ use anyhow::{Result, anyhow};
 use clap::Args;
 use cloudscape::frame::Frame;
 use cloudscape::gpu::PassTimer;
-use cloudscape::renderer::{PASSES, SceneRenderer};
+use cloudscape::raymarch::temporal::TemporalSettings;
+use cloudscape::renderer::{PASSES, Reuse, SceneRenderer};
 use glam::UVec2;
 use serde::Serialize;
 
@@ -23,8 +24,21 @@ pub struct BenchArgs {
     /// Print the result as JSON on stdout.
     #[arg(long)]
     json: bool,
+    /// March one ray per N x N pixels per frame (1, 2 or 4) and reuse history between frames.
+    #[arg(long, value_name = "N", value_parser = parse_divisor)]
+    temporal: Option<u32>,
     #[command(flatten)]
     gpu: GpuArgs,
+}
+
+/// A march-grid divisor: 1, 2 or 4.
+fn parse_divisor(text: &str) -> Result<u32, String> {
+    match text.parse::<u32>() {
+        Ok(n @ (1 | 2 | 4)) => Ok(n),
+        _ => Err(format!(
+            "{text} is not a march-grid divisor; allowed 1, 2 or 4"
+        )),
+    }
 }
 
 /// Summary of one timed quantity over the frames, milliseconds.
@@ -73,17 +87,26 @@ pub fn run(args: BenchArgs) -> Result<()> {
         .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
     let mut frame = Frame::from_scene(scene, UVec2::new(scene.render.width, scene.render.height));
     let mut timer = PassTimer::new(&ctx, PASSES.len() as u32);
+    let reuse = match args.temporal {
+        Some(divisor) => Reuse::Temporal(TemporalSettings {
+            divisor,
+            ..TemporalSettings::default()
+        }),
+        None => Reuse::None,
+    };
     let mut pass_ms: Vec<Vec<f64>> = vec![Vec::new(); PASSES.len()];
     let mut wall_ms = Vec::new();
     for i in 0..args.warmup + args.frames {
         frame.frame_index = i;
-        let wall = renderer.render_timed(&ctx, scene, &frame, &mut timer);
+        let wall = renderer.render_frame(&ctx, scene, &frame, reuse, &mut timer);
         if i < args.warmup {
             continue;
         }
         wall_ms.push(wall.as_secs_f64() * 1e3);
-        for ((_, ms), samples) in timer.read_ms(&ctx).into_iter().zip(&mut pass_ms) {
-            samples.push(ms);
+        for (label, ms) in timer.read_ms(&ctx) {
+            if let Some(k) = PASSES.iter().position(|p| *p == label) {
+                pass_ms[k].push(ms);
+            }
         }
     }
     let report = Report {

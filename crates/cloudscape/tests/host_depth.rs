@@ -5,7 +5,9 @@ use cloudscape::field::CloudField;
 use cloudscape::field::gpu::FieldGpu;
 use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, read_texture_rgba16f};
-use cloudscape::raymarch::{CLOUD_FORMAT, MarchSettings, RaymarchRenderer, RaymarchTargets};
+use cloudscape::raymarch::{
+    CLOUD_DEPTH_FORMAT, CLOUD_FORMAT, MarchGrid, MarchSettings, RaymarchRenderer, RaymarchTargets,
+};
 use cloudscape::scene::Scene;
 use glam::{UVec2, Vec4};
 
@@ -49,7 +51,12 @@ fn march_over_depth(depth: f32) -> (f32, f32) {
     let field = CloudField::new(&scene, std::path::Path::new(".")).expect("field");
     let field_gpu = FieldGpu::new(&ctx, &field);
     let mut pass = RaymarchRenderer::new(&ctx, &field_gpu);
-    pass.prepare(&ctx, &frame, &MarchSettings::from_scene(&scene));
+    pass.prepare(
+        &ctx,
+        &frame,
+        &MarchSettings::from_scene(&scene),
+        &MarchGrid::FULL,
+    );
     use wgpu::TextureUsages as U;
     let depth_texture = texture(
         &ctx,
@@ -76,6 +83,8 @@ fn march_over_depth(depth: f32) -> (f32, f32) {
     let targets = RaymarchTargets {
         depth: &depth_view,
         clouds: &clouds.create_view(&Default::default()),
+        cloud_depth: &texture(&ctx, size, CLOUD_DEPTH_FORMAT, U::STORAGE_BINDING)
+            .create_view(&Default::default()),
     };
     pass.encode(
         &ctx,

@@ -48,11 +48,13 @@ fn field_empty_until(o: vec3<f32>, d: vec3<f32>, t: f32, t_end: f32) -> vec2<f32
     let levels = field.counts.z;
     var level = min(4u, levels - 1u);
     var t_cur = t;
+    var result = vec2<f32>(t, t);
     for (var iteration = 0u; iteration < 32u; iteration++) {
         if t_cur >= t_end {
-            return vec2<f32>(t_end, t_end);
+            result = vec2<f32>(t_end, t_end);
+            break;
         }
-                // Look the cell up just past t_cur, so that a t_cur on a cell boundary finds the cell the
+        // Look the cell up just past t_cur, so that a t_cur on a cell boundary finds the cell the
         // ray is entering; t_cur itself stays exact, so no sample beyond a boundary is skipped.
         let p = o + d * (t_cur + 1.0e-3 + 1.0e-6 * t_cur);
         let h = field_altitude_m(p);
@@ -67,14 +69,17 @@ fn field_empty_until(o: vec3<f32>, d: vec3<f32>, t: f32, t_end: f32) -> vec2<f32
                 exit = min(exit, hiheight_descent_t(o, d, t_cur, cell.top_m));
             }
         }
-                if empty {
+        result = vec2<f32>(t_cur, t_cur);
+        if empty {
             t_cur = max(exit, t_cur + 1.0e-3 + 1.0e-6 * t_cur);
             level = min(level + 1u, levels - 1u);
+            result = vec2<f32>(t_cur, t_cur);
         } else if level == 0u {
-            return vec2<f32>(t_cur, max(exit, t_cur));
+            result = vec2<f32>(t_cur, max(exit, t_cur));
+            break;
         } else {
             level -= 1u;
         }
     }
-    return vec2<f32>(t_cur, t_cur);
+    return result;
 }

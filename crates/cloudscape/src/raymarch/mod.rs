@@ -13,10 +13,14 @@ use crate::scene::{Quality, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, UVec4, Vec4};
 
+pub mod temporal;
+
 const RAYMARCH_WGSL: &str = include_str!("raymarch.wgsl");
 
 /// Format of the cloud target: rgb in-scattered radiance, a transmittance.
 pub const CLOUD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Format of the cloud-depth target.
+pub const CLOUD_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// Source of the ray-march program.
 pub fn shader_source() -> String {
@@ -96,6 +100,35 @@ struct MarchUniform {
     ambient: Vec4,
     tile: UVec4,
     flags: UVec4,
+    grid: UVec4,
+    ray_offset: Vec4,
+}
+
+/// Which rays a march traces: one per pixel of a grid at 1/`divisor` of the frame's resolution,
+/// through sub-pixel `subpixel` of each block, offset along the ray by white noise (stills) or by a
+/// frame's Halton value plus the seed's Bayer pattern (temporal reuse).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MarchGrid {
+    /// 1, 2 or 4: the grid has 1/divisor of the frame's pixels along each axis.
+    pub divisor: u32,
+    /// The pixel of each divisor x divisor block the rays go through.
+    pub subpixel: UVec2,
+    /// Halton offset along the rays, for temporal reuse; None for independent white noise.
+    pub temporal_offset: Option<f32>,
+}
+
+impl MarchGrid {
+    /// Every pixel, white-noise offsets: stills.
+    pub const FULL: MarchGrid = MarchGrid {
+        divisor: 1,
+        subpixel: UVec2::ZERO,
+        temporal_offset: None,
+    };
+
+    /// Grid size for a frame of `size` pixels.
+    pub fn size(&self, size: UVec2) -> UVec2 {
+        (size + self.divisor - 1) / self.divisor
+    }
 }
 
 /// What the march did, counted on the GPU since the last [`RaymarchRenderer::prepare`].
@@ -111,8 +144,11 @@ pub struct MarchStats {
 pub struct RaymarchTargets<'a> {
     /// The host's depth buffer (Depth32Float, 0 near, 1 far, from `Frame::clip_from_view`).
     pub depth: &'a wgpu::TextureView,
-    /// Output, [`CLOUD_FORMAT`] with STORAGE_BINDING, the frame's size.
+    /// Output, [`CLOUD_FORMAT`] with STORAGE_BINDING, the march grid's size.
     pub clouds: &'a wgpu::TextureView,
+    /// Output, [`CLOUD_DEPTH_FORMAT`] with STORAGE_BINDING, the march grid's size: the
+    /// transmittance-weighted distance to the cloud in metres (0 where there is none).
+    pub cloud_depth: &'a wgpu::TextureView,
 }
 
 /// The ray-march pass.
@@ -149,6 +185,7 @@ impl RaymarchRenderer {
                 depth,
                 storage_texture_2d(CLOUD_FORMAT),
                 STATS,
+                storage_texture_2d(CLOUD_DEPTH_FORMAT),
             ],
         );
         let pipeline = compute_pipeline(
@@ -197,7 +234,13 @@ impl RaymarchRenderer {
     }
 
     /// Uploads the frame and settings for the next [`RaymarchRenderer::encode`].
-    pub fn prepare(&mut self, ctx: &GpuContext, frame: &Frame, settings: &MarchSettings) {
+    pub fn prepare(
+        &mut self,
+        ctx: &GpuContext,
+        frame: &Frame,
+        settings: &MarchSettings,
+        grid: &MarchGrid,
+    ) {
         let [a, b, c] = settings.octave_factors;
         self.settings = MarchUniform {
             counts: UVec4::new(
@@ -216,6 +259,13 @@ impl RaymarchRenderer {
             ),
             tile: UVec4::ZERO,
             flags: UVec4::new(settings.empty_space_skipping as u32, 0, 0, 0),
+            grid: UVec4::new(
+                grid.divisor,
+                grid.subpixel.x,
+                grid.subpixel.y,
+                grid.temporal_offset.is_some() as u32,
+            ),
+            ray_offset: Vec4::new(grid.temporal_offset.unwrap_or(0.0), 0.0, 0.0, 0.0),
         };
         ctx.queue
             .write_buffer(&self.stats, 0, bytemuck::bytes_of(&[0u32; 2]));
@@ -251,6 +301,7 @@ impl RaymarchRenderer {
                 wgpu::BindingResource::TextureView(targets.depth),
                 wgpu::BindingResource::TextureView(targets.clouds),
                 self.stats.as_entire_binding(),
+                wgpu::BindingResource::TextureView(targets.cloud_depth),
             ],
         );
         dispatch_2d(
