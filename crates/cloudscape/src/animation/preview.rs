@@ -22,7 +22,7 @@ pub enum PreviewError {
     /// The preview would be larger than a GIF can be (65 535 pixels a side).
     #[error("a {0}x{1} pixel preview is larger than a GIF allows (65535 a side)")]
     TooLarge(u32, u32),
-    /// A frame's pixel buffer does not hold `width * height` pixels.
+    /// A frame is empty, or its pixel buffer does not hold `width * height` pixels.
     #[error("a {width}x{height} frame holds {len} pixels")]
     BadFrame {
         /// Declared width.
@@ -77,21 +77,19 @@ impl GifPreview {
         })
     }
 
-    /// The preview's size in pixels.
-    pub fn size(&self) -> UVec2 {
-        self.size
-    }
-
     /// Appends `frame`, scaled to the preview size.
     pub fn push(&mut self, frame: &LdrImage) -> Result<(), PreviewError> {
-        let bytes = bytemuck::cast_slice::<[u8; 4], u8>(&frame.pixels).to_vec();
-        let image = RgbaImage::from_raw(frame.width, frame.height, bytes).ok_or(
-            PreviewError::BadFrame {
-                width: frame.width,
-                height: frame.height,
-                len: frame.pixels.len(),
-            },
-        )?;
+        let bad_frame = PreviewError::BadFrame {
+            width: frame.width,
+            height: frame.height,
+            len: frame.pixels.len(),
+        };
+        let pixels = frame.width as usize * frame.height as usize;
+        if pixels == 0 || frame.pixels.len() != pixels {
+            return Err(bad_frame);
+        }
+        let bytes = frame.pixels.as_flattened().to_vec();
+        let image = RgbaImage::from_raw(frame.width, frame.height, bytes).ok_or(bad_frame)?;
         let mut pixels = resize(&image, self.size.x, self.size.y, FilterType::Triangle).into_raw();
         // `new` checked that the size fits in u16.
         let (width, height) = (self.size.x as u16, self.size.y as u16);
@@ -100,11 +98,6 @@ impl GifPreview {
         self.encoder.write_frame(&gif_frame)?;
         self.frames += 1;
         Ok(())
-    }
-
-    /// Frames pushed so far.
-    pub fn frames(&self) -> u32 {
-        self.frames
     }
 
     /// Finishes the GIF and writes it to `path` (complete or not at all).
