@@ -1,5 +1,6 @@
 //! `cloudscape`: render, export and benchmark cloud scenes from the command line.
 
+mod animate;
 mod bench;
 mod common;
 mod export;
@@ -24,6 +25,9 @@ enum Command {
     Export(export::ExportArgs),
     /// Time the GPU passes of a scene over many frames.
     Bench(bench::BenchArgs),
+    /// Render a scene's frames over scene time (camera, sun and coverage paths, wind) to PNG or
+    /// EXR files, with an animated GIF preview (and an MP4 when ffmpeg is on PATH).
+    Animate(animate::AnimateArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -32,6 +36,7 @@ fn main() -> std::process::ExitCode {
         Command::Render(args) => render::run(args),
         Command::Export(args) => export::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Animate(args) => animate::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -37,6 +37,9 @@ pub struct Scene {
     pub lighting: Lighting,
     /// Image size, technique, quality, exposure and output.
     pub render: RenderSettings,
+    /// Keyframed camera, sun and coverage over scene time; empty (a static scene) by default.
+    #[serde(skip_serializing_if = "Animation::is_static")]
+    pub animation: Animation,
 }
 
 impl Default for Scene {
@@ -54,6 +57,7 @@ impl Default for Scene {
             phase: PhaseFunction::default(),
             lighting: Lighting::default(),
             render: RenderSettings::default(),
+            animation: Animation::default(),
         }
     }
 }
@@ -530,4 +534,71 @@ impl Default for RenderSettings {
             output: "cloudscape.png".to_string(),
         }
     }
+}
+
+/// Changes over scene time, as keyframed paths (see [`crate::animation`]). Each path is either
+/// empty (that part of the scene stays as the rest of the scene says) or holds at least 2 keyframes
+/// with strictly increasing `time_s`. Before its first keyframe and after its last, a path holds.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Animation {
+    /// Camera keyframes: position, and orientation by look-at point or by yaw and pitch.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub camera_path: Vec<CameraKey>,
+    /// Sun keyframes: elevation and azimuth.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub time_of_day: Vec<SunKey>,
+    /// Keyframes of a factor on every layer's coverage: clouds grow (> 1) and decay (< 1).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub coverage_scale: Vec<CoverageKey>,
+}
+
+impl Animation {
+    /// Whether no path is given: the scene looks the same at every time but for the wind.
+    pub fn is_static(&self) -> bool {
+        self.camera_path.is_empty() && self.time_of_day.is_empty() && self.coverage_scale.is_empty()
+    }
+}
+
+/// One keyframe of the camera path.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraKey {
+    /// Scene time of the keyframe, seconds; later than the previous keyframe's.
+    pub time_s: f32,
+    /// Eye position in metres.
+    pub position_m: [f32; 3],
+    /// Point looked at, metres (not the eye position); either every keyframe has one or none has.
+    #[serde(default)]
+    pub look_at_m: Option<[f32; 3]>,
+    /// View azimuth in degrees clockwise from north, used without `look_at_m`; the camera turns the
+    /// short way round between keyframes.
+    #[serde(default)]
+    pub yaw_deg: f32,
+    /// View elevation in degrees above the horizon, -90..90, used without `look_at_m`.
+    #[serde(default)]
+    pub pitch_deg: f32,
+}
+
+/// One keyframe of the sun's path over the sky.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SunKey {
+    /// Scene time of the keyframe, seconds; later than the previous keyframe's.
+    pub time_s: f32,
+    /// Sun elevation above the horizon in degrees, -90..90.
+    pub sun_elevation_deg: f32,
+    /// Sun azimuth in degrees clockwise from north; less than 90 degrees of sky from the previous
+    /// keyframe's sun.
+    pub sun_azimuth_deg: f32,
+}
+
+/// One keyframe of the coverage factor.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoverageKey {
+    /// Scene time of the keyframe, seconds; later than the previous keyframe's.
+    pub time_s: f32,
+    /// Factor on every layer's `coverage`, >= 0; the product is clamped to 0..1.
+    pub scale: f32,
 }
