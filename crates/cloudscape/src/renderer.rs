@@ -5,6 +5,7 @@
 use crate::field::gpu::FieldGpu;
 use crate::field::{CloudField, FieldError};
 use crate::frame::Frame;
+use crate::gpu::pipeline::{STORAGE_OUTPUT, texture_2d};
 use crate::gpu::timing::PassTimer;
 use crate::gpu::{GpuContext, readback};
 use crate::image::{HdrImage, LdrImage};
@@ -54,24 +55,9 @@ struct Targets {
 
 impl Targets {
     fn new(ctx: &GpuContext, size: UVec2) -> Targets {
-        let texture = |label, format, usage| {
-            ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: size.x,
-                    height: size.y,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let texture = |label, format, usage| texture_2d(ctx, label, size, format, usage);
         use wgpu::TextureUsages as U;
-        let storage = U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC;
+        let storage = STORAGE_OUTPUT;
         let depth = texture(
             "depth",
             wgpu::TextureFormat::Depth32Float,

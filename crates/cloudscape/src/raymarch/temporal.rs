@@ -9,8 +9,8 @@ use crate::field::gpu::FieldGpu;
 use crate::frame::{FRAME_WGSL, Frame};
 use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{
-    UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d, float_texture,
-    storage_texture_2d,
+    STORAGE_OUTPUT, UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d,
+    float_texture, storage_texture_2d, texture_2d,
 };
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
@@ -302,25 +302,7 @@ impl TemporalMarch {
             return;
         }
         let texture = |label, size: UVec2, format| {
-            let usage = wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC;
-            ctx.device
-                .create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d {
-                        width: size.x,
-                        height: size.y,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-                .create_view(&Default::default())
+            texture_2d(ctx, label, size, format, STORAGE_OUTPUT).create_view(&Default::default())
         };
         let grid_size = grid.size(size);
         self.buffers = Some(Buffers {
