@@ -2,7 +2,9 @@
 
 mod bench;
 mod common;
+mod compare;
 mod export;
+mod reference;
 mod render;
 
 use clap::{Parser, Subcommand};
@@ -24,6 +26,10 @@ enum Command {
     Export(export::ExportArgs),
     /// Time the GPU passes of a scene over many frames.
     Bench(bench::BenchArgs),
+    /// Path-trace a scene on the CPU: the ground truth the real-time techniques are measured by.
+    Reference(reference::ReferenceArgs),
+    /// Compare an image with a reference: HDR-FLIP, relative MSE, mean luminance ratio.
+    Compare(compare::CompareArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -32,6 +38,8 @@ fn main() -> std::process::ExitCode {
         Command::Render(args) => render::run(args),
         Command::Export(args) => export::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Reference(args) => reference::run(args),
+        Command::Compare(args) => compare::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -81,15 +81,14 @@ impl CloudMedium {
         &self.field
     }
 
-    /// Bound of one layer's extinction over `b`.
-    fn layer_bound(&self, layer: &LayerField, b: &Aabb) -> f32 {
+    /// Bound of one layer's extinction over `b`, whose footprint has the weather bound `w`.
+    fn layer_bound(&self, layer: &LayerField, w: &WeatherBound, b: &Aabb) -> f32 {
         let (h0, h1) = altitude_range(&self.field.planet, b);
         let f0 = ((h0 - layer.bottom_m) / layer.thickness_m).max(0.0);
         let f1 = ((h1 - layer.bottom_m) / layer.thickness_m).min(1.0);
         if f1 < f0 {
             return 0.0;
         }
-        let w = self.weather_bound(layer, b);
         let coverage = layer.local_coverage(w.coverage_max);
         if coverage <= 0.0 {
             return 0.0;
@@ -130,14 +129,37 @@ impl Medium for CloudMedium {
     }
 
     fn max_extinction_in_box(&self, b: &Aabb) -> f32 {
-        let layers: f32 = self
+        let mut bound = [0.0];
+        self.max_extinction_in_column(std::slice::from_ref(b), &mut bound);
+        bound[0]
+    }
+
+    fn max_extinction_in_column(&self, cells: &[Aabb], out: &mut [f32]) {
+        let Some(footprint) = cells.first() else {
+            return;
+        };
+        let weather: Vec<WeatherBound> = self
             .field
             .layers
             .iter()
-            .map(|l| self.layer_bound(l, b))
-            .sum();
-        let volumes: f32 = self.field.volumes.iter().map(|v| volume_bound(v, b)).sum();
-        layers + volumes
+            .map(|l| self.weather_bound(l, footprint))
+            .collect();
+        for (cell, bound) in cells.iter().zip(out) {
+            let layers: f32 = self
+                .field
+                .layers
+                .iter()
+                .zip(&weather)
+                .map(|(l, w)| self.layer_bound(l, w, cell))
+                .sum();
+            let volumes: f32 = self
+                .field
+                .volumes
+                .iter()
+                .map(|v| volume_bound(v, cell))
+                .sum();
+            *bound = layers + volumes;
+        }
     }
 
     fn support(&self) -> Support {

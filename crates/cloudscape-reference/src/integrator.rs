@@ -13,8 +13,8 @@
 //! - the continuation: the phase function sampled exactly, or the cosine-weighted hemisphere.
 //!
 //! Throughput is multiplied by the single-scattering albedo at each collision and by the ground
-//! albedo at each bounce; Russian roulette on the throughput (survival probability its largest
-//! component, at most 1) ends paths without bias. Paths have no practical bounce limit.
+//! albedo at each bounce; Russian roulette on a low throughput ends paths without bias. Paths have
+//! no practical bounce limit ([`MAX_SCATTERING_EVENTS`]).
 //!
 //! Haze: the GPU passes blend what the eye sees toward the horizon radiance by the distance of
 //! what it sees. Here the primary vertex's radiance is blended by its distance, which is the same
@@ -69,11 +69,17 @@ pub struct PathTracer<M> {
 impl<M: Medium> PathTracer<M> {
     /// One estimate of the radiance through the image point `pixel` (pixel units, y down).
     pub fn radiance(&self, pixel: Vec2, rng: &mut Rng) -> Vec3 {
-        let env = &self.environment;
         let (origin, dir) = self.frame.camera_ray(pixel);
+        self.ray_radiance(origin, dir, self.frame.far_m, rng)
+    }
+
+    /// One estimate of the radiance arriving at `origin` from direction `-dir` (what a camera at
+    /// `origin` looking along `dir` sees), with the medium and the ground seen no farther than
+    /// `far_m` (as the GPU techniques march no farther than the camera's far distance).
+    pub fn ray_radiance(&self, origin: Vec3, dir: Vec3, far_m: f32, rng: &mut Rng) -> Vec3 {
+        let env = &self.environment;
         let ground_m = env.ground_distance(origin, dir);
-        // The GPU marches to the far distance only, and shows the ground only before it.
-        let t_max = self.frame.far_m.min(ground_m);
+        let t_max = far_m.min(ground_m);
         let (vertex, distance_m) = match self.volume.free_flight(origin, dir, t_max, rng) {
             Some(t) => (
                 Vertex::Medium {
@@ -82,7 +88,7 @@ impl<M: Medium> PathTracer<M> {
                 },
                 t,
             ),
-            None if ground_m <= self.frame.far_m => (
+            None if ground_m.is_finite() && ground_m <= far_m => (
                 Vertex::Ground(env.ground_point(origin + dir * ground_m)),
                 ground_m,
             ),
@@ -105,11 +111,9 @@ impl<M: Medium> PathTracer<M> {
             radiance += throughput * (self.sun_light(vertex, rng) + self.sky_light(vertex, rng));
             let next = self.continue_from(vertex, rng);
             throughput *= next.weight;
-            let survival = throughput.max_element().min(1.0);
-            if survival <= 0.0 || rng.next_f32() >= survival {
+            if !roulette(&mut throughput, rng) {
                 break;
             }
-            throughput /= survival;
             let origin = position(vertex);
             let ground_m = self.environment.ground_distance(origin, next.dir);
             vertex = match self.volume.free_flight(origin, next.dir, ground_m, rng) {
@@ -197,6 +201,26 @@ impl<M: Medium> PathTracer<M> {
             },
         }
     }
+}
+
+/// Below this largest throughput component, paths play Russian roulette.
+const ROULETTE_THRESHOLD: f32 = 0.25;
+
+/// Russian roulette (Arvo & Kirk 1990, "Particle Transport and Image Synthesis"): a path whose
+/// throughput `beta` has fallen below [`ROULETTE_THRESHOLD`] survives with probability
+/// `max(beta) / threshold` and then carries `beta * threshold / max(beta)`, which keeps every
+/// estimate unbiased. Returns whether the path goes on.
+fn roulette(throughput: &mut Vec3, rng: &mut Rng) -> bool {
+    let largest = throughput.max_element();
+    if largest >= ROULETTE_THRESHOLD {
+        return true;
+    }
+    let survival = largest / ROULETTE_THRESHOLD;
+    if survival <= 0.0 || rng.next_f32() >= survival {
+        return false;
+    }
+    *throughput /= survival;
+    true
 }
 
 /// Where paths leave a vertex from.

@@ -14,6 +14,14 @@ pub trait Medium: Sync {
     /// must never be exceeded (delta tracking is biased wherever it is): prove it, do not sample it.
     fn max_extinction_in_box(&self, b: &Aabb) -> f32;
 
+    /// [`Medium::max_extinction_in_box`] of each of `cells`, which all share one x-z footprint
+    /// (a column of the majorant grid), into `out`. Override it when work can be shared.
+    fn max_extinction_in_column(&self, cells: &[Aabb], out: &mut [f32]) {
+        for (cell, bound) in cells.iter().zip(out) {
+            *bound = self.max_extinction_in_box(cell);
+        }
+    }
+
     /// Where the extinction may be non-zero.
     fn support(&self) -> Support;
 }
