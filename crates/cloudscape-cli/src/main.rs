@@ -6,6 +6,7 @@ mod compare;
 mod export;
 mod reference;
 mod render;
+mod report;
 
 use clap::{Parser, Subcommand};
 
@@ -30,6 +31,9 @@ enum Command {
     Reference(reference::ReferenceArgs),
     /// Compare an image with a reference: HDR-FLIP, relative MSE, mean luminance ratio.
     Compare(compare::CompareArgs),
+    /// Render the canonical scenes with the ray marcher and the path tracer, compare them, and
+    /// write `docs/realism.md`.
+    Report(report::ReportArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -40,6 +44,7 @@ fn main() -> std::process::ExitCode {
         Command::Bench(args) => bench::run(args),
         Command::Reference(args) => reference::run(args),
         Command::Compare(args) => compare::run(args),
+        Command::Report(args) => report::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -22,7 +22,7 @@ const MAX_GRID_REACH_M: f32 = 150_000.0;
 
 impl PathTracer<CloudMedium> {
     /// The path tracer of `scene` at `size` pixels; files resolve against `base_dir`. Bakes the
-    /// noise and builds a majorant grid of about `majorant_cells` cells (see
+    /// noise (when there are layers) and builds a majorant grid of about `majorant_cells` cells (see
     /// [`DEFAULT_MAJORANT_CELLS`]).
     pub fn for_scene(
         scene: &Scene,
@@ -31,7 +31,9 @@ impl PathTracer<CloudMedium> {
         majorant_cells: usize,
     ) -> Result<PathTracer<CloudMedium>, FieldError> {
         let field = CloudField::new(scene, base_dir)?;
-        field.bake_noise();
+        if !field.layers.is_empty() {
+            field.bake_noise();
+        }
         let frame = Frame::from_scene(scene, size);
         let environment = Environment::from_frame(&frame, field.planet);
         let reach_m = frame.far_m.min(MAX_GRID_REACH_M);
