@@ -186,7 +186,10 @@ fn scene_row(
     write_image(&image_path("reference"), &full, ev, op)?;
     eprintln!(
         "HDR-FLIP {:.4} relMSE {:.4} (noise floor {:.4} {:.4})",
-        comparison.flip_mean, comparison.relative_mse, noise_floor.flip_mean, noise_floor.relative_mse
+        comparison.flip_mean,
+        comparison.relative_mse,
+        noise_floor.flip_mean,
+        noise_floor.relative_mse
     );
     Ok(Row {
         name: canonical.name,
@@ -218,7 +221,8 @@ fn cached_reference(doc: &SceneDocument, args: &ReportArgs) -> Result<Reference>
         std::fs::read_to_string(&stats_path),
     ) {
         let mut numbers = stats.split_whitespace().filter_map(|s| s.parse().ok());
-        let (samples_per_second, spp) = (numbers.next().unwrap_or(0.0), numbers.next().unwrap_or(0.0));
+        let (samples_per_second, spp) =
+            (numbers.next().unwrap_or(0.0), numbers.next().unwrap_or(0.0));
         eprintln!("reference from the cache ({key})");
         return Ok(Reference {
             halves: [a, b],
@@ -227,8 +231,13 @@ fn cached_reference(doc: &SceneDocument, args: &ReportArgs) -> Result<Reference>
         });
     }
     let size = UVec2::new(doc.scene.render.width, doc.scene.render.height);
-    let tracer = PathTracer::for_scene(&doc.scene, &doc.resolve_path(""), size, DEFAULT_MAJORANT_CELLS)
-        .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
+    let tracer = PathTracer::for_scene(
+        &doc.scene,
+        &doc.resolve_path(""),
+        size,
+        DEFAULT_MAJORANT_CELLS,
+    )
+    .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
     let budget = Duration::from_secs_f64(args.time_budget / 2.0);
     let (mut samples, mut seconds) = (0u64, 0.0);
     let halves = [0u64, 1].map(|h| {
@@ -253,8 +262,14 @@ fn cached_reference(doc: &SceneDocument, args: &ReportArgs) -> Result<Reference>
     for (path, half) in paths.iter().zip(&reference.halves) {
         half.write_exr(path)?;
     }
-    std::fs::write(&stats_path, format!("{} {}", reference.samples_per_second, reference.spp))?;
-    eprintln!("traced {:.0} samples/s, {:.1} spp", reference.samples_per_second, reference.spp);
+    std::fs::write(
+        &stats_path,
+        format!("{} {}", reference.samples_per_second, reference.spp),
+    )?;
+    eprintln!(
+        "traced {:.0} samples/s, {:.1} spp",
+        reference.samples_per_second, reference.spp
+    );
     Ok(reference)
 }
 
@@ -279,7 +294,10 @@ fn average([a, b]: &[HdrImage; 2]) -> HdrImage {
         .zip(&b.pixels)
         .map(|(p, q)| std::array::from_fn(|c| 0.5 * (p[c] + q[c])))
         .collect();
-    HdrImage { pixels, ..a.clone() }
+    HdrImage {
+        pixels,
+        ..a.clone()
+    }
 }
 
 /// Writes the voxel-grid cloud (a few merged puffs over a flat base, roughened by Perlin noise)
@@ -364,7 +382,10 @@ fn markdown(rows: &[Row], args: &ReportArgs, adapter: &str) -> String {
             r.gpu_ms
         );
     }
-    let _ = writeln!(s, "\n## Images\n\nRay marcher | path tracer | HDR-FLIP error (magma)\n");
+    let _ = writeln!(
+        s,
+        "\n## Images\n\nRay marcher | path tracer | HDR-FLIP error (magma)\n"
+    );
     for r in rows {
         let _ = writeln!(
             s,

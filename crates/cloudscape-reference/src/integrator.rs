@@ -10,7 +10,8 @@
 //!   phase-sampled continuation by the power heuristic (Veach 1997, "Robust Monte Carlo Methods
 //!   for Light Transport Simulation", section 9.2); on the ground the cosine-sampled continuation
 //!   alone gathers the sky (it already samples the BRDF times cosine exactly);
-//! - the continuation: the phase function sampled exactly, or the cosine-weighted hemisphere.
+//! - the continuation: the phase function sampled exactly (or the cosine-weighted hemisphere on
+//!   the ground), mixed with a narrow lobe about the sun that finds the forward-scattered aureole.
 //!
 //! Throughput is multiplied by the single-scattering albedo at each collision and by the ground
 //! albedo at each bounce; Russian roulette on a low throughput ends paths without bias. Paths have
@@ -42,12 +43,12 @@ enum Vertex {
     Ground(GroundPoint),
 }
 
-/// A continuation direction, the factor it multiplies the throughput by, and the density of sky
-/// sampling for it (0 where the sky's next-event estimation did not compete).
+/// A continuation direction, the factor it multiplies the throughput by, its density, and the
+/// density of sky sampling for it (0 where the sky's next-event estimation did not compete).
 struct Continuation {
     dir: Vec3,
     weight: Vec3,
-    phase_pdf: f32,
+    pdf: f32,
     sky_pdf: f32,
 }
 
@@ -125,7 +126,7 @@ impl<M: Medium> PathTracer<M> {
                     Vertex::Ground(self.environment.ground_point(origin + next.dir * ground_m))
                 }
                 None => {
-                    let weight = power_heuristic(next.phase_pdf, next.sky_pdf);
+                    let weight = power_heuristic(next.pdf, next.sky_pdf);
                     radiance += throughput * self.environment.sky_radiance(next.dir) * weight;
                     break;
                 }
@@ -160,19 +161,19 @@ impl<M: Medium> PathTracer<M> {
     }
 
     /// Next-event estimate of the sky's light scattered at a medium vertex, weighted against
-    /// phase sampling by the power heuristic.
+    /// the continuation's sampling by the power heuristic.
     fn sky_light(&self, vertex: Vertex, rng: &mut Rng) -> Vec3 {
-        let Vertex::Medium { position, dir } = vertex else {
+        let Vertex::Medium { position, .. } = vertex else {
             return Vec3::ZERO;
         };
         let (sky_dir, sky_pdf) = self.environment.sample_sky(position, rng.next_vec2());
-        let phase = self.phase.eval(dir.dot(sky_dir));
-        let weight = power_heuristic(sky_pdf, phase);
+        let (phase, continuation_pdf) = self.scattering(vertex, sky_dir);
+        let weight = power_heuristic(sky_pdf, continuation_pdf);
         if weight <= 0.0 {
             return Vec3::ZERO;
         }
         let transmittance = self.visibility(position, sky_dir, rng);
-        self.environment.sky_radiance(sky_dir) * (phase * weight * transmittance / sky_pdf)
+        self.environment.sky_radiance(sky_dir) * phase * (weight * transmittance / sky_pdf)
     }
 
     /// Lambertian BRDF of the ground, `albedo / pi`.
@@ -180,28 +181,70 @@ impl<M: Medium> PathTracer<M> {
         self.environment.ground_albedo.unwrap_or(Vec3::ZERO) / PI
     }
 
-    /// Samples the direction a path leaves `vertex` in.
-    fn continue_from(&self, vertex: Vertex, rng: &mut Rng) -> Continuation {
-        match vertex {
-            Vertex::Medium { position, dir } => {
-                let next = self.phase.sample(dir, rng.next_vec3());
-                Continuation {
-                    dir: next,
-                    weight: Vec3::ONE,
-                    phase_pdf: self.phase.eval(dir.dot(next)),
-                    sky_pdf: self.environment.sky_pdf(position, next),
-                }
+    /// The sun lobe that continuations are partly drawn from, with its probability; None
+    /// without a sun.
+    fn sun_guide(&self) -> Option<(Vec3, PhaseLobes)> {
+        let sun = self.environment.sun?;
+        Some((sun.direction, PhaseLobes::henyey_greenstein(SUN_GUIDE_G)))
+    }
+
+    /// At `vertex`, for leaving toward `next`: the scattering factor (phase function, or BRDF
+    /// times cosine) and the density of the continuation sampling, the mixture of the vertex's
+    /// own sampling and the sun lobe.
+    fn scattering(&self, vertex: Vertex, next: Vec3) -> (Vec3, f32) {
+        let (value, own_pdf) = match vertex {
+            Vertex::Medium { dir, .. } => {
+                let p = self.phase.eval(dir.dot(next));
+                (Vec3::splat(p), p)
             }
-            Vertex::Ground(g) => Continuation {
-                dir: crate::sampling::cosine_hemisphere(g.normal, rng.next_vec2()),
-                // BRDF * cos / (cos / pi) = albedo.
-                weight: self.environment.ground_albedo.unwrap_or(Vec3::ZERO),
-                phase_pdf: 1.0,
-                sky_pdf: 0.0,
-            },
+            Vertex::Ground(g) => {
+                let cos = g.normal.dot(next).max(0.0);
+                (self.ground_brdf() * cos, cos / PI)
+            }
+        };
+        let pdf = match self.sun_guide() {
+            Some((toward, lobe)) => {
+                SUN_GUIDE_PROBABILITY * lobe.eval(toward.dot(next))
+                    + (1.0 - SUN_GUIDE_PROBABILITY) * own_pdf
+            }
+            None => own_pdf,
+        };
+        (value, pdf)
+    }
+
+    /// Samples the direction a path leaves `vertex` in: the phase function (or the cosine-weighted
+    /// hemisphere on the ground), or with probability [`SUN_GUIDE_PROBABILITY`] a narrow lobe
+    /// about the sun. The sun lobe finds the bright aureole that the forward peak of cloud
+    /// droplets makes around the sun in thin cloud, which the other sampling finds only rarely
+    /// and then as a firefly; the throughput weight `f / (mixture pdf)` keeps it unbiased
+    /// (one-sample multiple importance sampling, Veach 1997, section 9.2.4).
+    fn continue_from(&self, vertex: Vertex, rng: &mut Rng) -> Continuation {
+        let guide = self.sun_guide();
+        let dir = match (guide, vertex) {
+            (Some((toward, lobe)), _) if rng.next_f32() < SUN_GUIDE_PROBABILITY => {
+                lobe.sample(toward, rng.next_vec3())
+            }
+            (_, Vertex::Medium { dir, .. }) => self.phase.sample(dir, rng.next_vec3()),
+            (_, Vertex::Ground(g)) => crate::sampling::cosine_hemisphere(g.normal, rng.next_vec2()),
+        };
+        let (value, pdf) = self.scattering(vertex, dir);
+        let sky_pdf = match vertex {
+            Vertex::Medium { position, .. } => self.environment.sky_pdf(position, dir),
+            Vertex::Ground(_) => 0.0,
+        };
+        Continuation {
+            dir,
+            weight: if pdf > 0.0 { value / pdf } else { Vec3::ZERO },
+            pdf,
+            sky_pdf,
         }
     }
 }
+
+/// Probability of drawing a continuation from the sun lobe instead of the vertex's own sampling.
+const SUN_GUIDE_PROBABILITY: f32 = 0.1;
+/// Asymmetry of the Henyey-Greenstein sun lobe: most of it within a few degrees of the sun.
+const SUN_GUIDE_G: f32 = 0.99;
 
 /// Below this largest throughput component, paths play Russian roulette.
 const ROULETTE_THRESHOLD: f32 = 0.25;

@@ -114,6 +114,41 @@ fn conservative_slab_matches_adding_doubling() {
     }
 }
 
+/// Energy conservation under the sun: a conservative slab lit by a (wide) sun from straight
+/// above reflects and transmits all of it, so the fluxes seen above and below (the direct beam
+/// included, through the sun's disc) add up to the incident irradiance. This exercises sun
+/// next-event estimation, the sun-guided continuations and the sun disc seen directly.
+#[test]
+fn sunlit_conservative_slab_conserves_energy() {
+    use cloudscape_reference::environment::SunDisc;
+    let sun = SunDisc {
+        direction: Vec3::Y,
+        irradiance: Vec3::ONE,
+        cos_radius: 5f32.to_radians().cos(),
+    };
+    let t = tracer(
+        slab(2.0),
+        PhaseLobes::approximate_mie(20.0),
+        1.0,
+        environment(two_tone_sky(0.0, 0.0), Some(sun)),
+        UVec2::ONE,
+    );
+    let flux = |origin: Vec3, up: Vec3| {
+        mean_and_error(60_000, |rng| {
+            let dir = cosine_hemisphere(up, rng.next_vec2());
+            std::f64::consts::PI * f64::from(t.ray_radiance(origin, dir, f32::INFINITY, rng).x)
+        })
+    };
+    let (r, r_error) = flux(Vec3::new(0.0, 101.0, 0.0), Vec3::NEG_Y);
+    let (tr, t_error) = flux(Vec3::new(0.0, -1.0, 0.0), Vec3::Y);
+    let error = (r_error * r_error + t_error * t_error).sqrt();
+    assert!(
+        (r + tr - 1.0).abs() < 4.0 * error + 2e-3,
+        "R {r} + T {tr} (+- {error})"
+    );
+    assert!(r > 0.05 && tr > 0.5, "R {r}, T {tr}");
+}
+
 /// A sunlit cube over a ground seen at one pixel: two seeds give estimates that agree within
 /// their estimated variance, and the same seed gives the same image however the passes split.
 #[test]
