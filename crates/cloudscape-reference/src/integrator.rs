@@ -105,12 +105,14 @@ impl<M: Medium> PathTracer<M> {
     fn path_radiance(&self, mut vertex: Vertex, rng: &mut Rng) -> Vec3 {
         let mut throughput = Vec3::ONE;
         let mut radiance = Vec3::ZERO;
-        for _ in 0..MAX_SCATTERING_EVENTS {
+        for events in 0..MAX_SCATTERING_EVENTS {
             if matches!(vertex, Vertex::Medium { .. }) {
                 throughput *= self.albedo;
             }
-            radiance += throughput * (self.sun_light(vertex, rng) + self.sky_light(vertex, rng));
-            let next = self.continue_from(vertex, rng);
+            let guided = events < SUN_GUIDED_EVENTS;
+            radiance +=
+                throughput * (self.sun_light(vertex, rng) + self.sky_light(vertex, guided, rng));
+            let next = self.continue_from(vertex, guided, rng);
             throughput *= next.weight;
             if !roulette(&mut throughput, rng) {
                 break;
@@ -162,12 +164,12 @@ impl<M: Medium> PathTracer<M> {
 
     /// Next-event estimate of the sky's light scattered at a medium vertex, weighted against
     /// the continuation's sampling by the power heuristic.
-    fn sky_light(&self, vertex: Vertex, rng: &mut Rng) -> Vec3 {
+    fn sky_light(&self, vertex: Vertex, guided: bool, rng: &mut Rng) -> Vec3 {
         let Vertex::Medium { position, .. } = vertex else {
             return Vec3::ZERO;
         };
         let (sky_dir, sky_pdf) = self.environment.sample_sky(position, rng.next_vec2());
-        let (phase, continuation_pdf) = self.scattering(vertex, sky_dir);
+        let (phase, continuation_pdf) = self.scattering(vertex, guided, sky_dir);
         let weight = power_heuristic(sky_pdf, continuation_pdf);
         if weight <= 0.0 {
             return Vec3::ZERO;
@@ -181,17 +183,17 @@ impl<M: Medium> PathTracer<M> {
         self.environment.ground_albedo.unwrap_or(Vec3::ZERO) / PI
     }
 
-    /// The sun lobe that continuations are partly drawn from, with its probability; None
-    /// without a sun.
-    fn sun_guide(&self) -> Option<(Vec3, PhaseLobes)> {
-        let sun = self.environment.sun?;
+    /// The sun lobe that continuations are partly drawn from: its direction and shape; None
+    /// without a sun or where the vertex is not `guided`.
+    fn sun_guide(&self, guided: bool) -> Option<(Vec3, PhaseLobes)> {
+        let sun = self.environment.sun.filter(|_| guided)?;
         Some((sun.direction, PhaseLobes::henyey_greenstein(SUN_GUIDE_G)))
     }
 
     /// At `vertex`, for leaving toward `next`: the scattering factor (phase function, or BRDF
     /// times cosine) and the density of the continuation sampling, the mixture of the vertex's
     /// own sampling and the sun lobe.
-    fn scattering(&self, vertex: Vertex, next: Vec3) -> (Vec3, f32) {
+    fn scattering(&self, vertex: Vertex, guided: bool, next: Vec3) -> (Vec3, f32) {
         let (value, own_pdf) = match vertex {
             Vertex::Medium { dir, .. } => {
                 let p = self.phase.eval(dir.dot(next));
@@ -202,7 +204,7 @@ impl<M: Medium> PathTracer<M> {
                 (self.ground_brdf() * cos, cos / PI)
             }
         };
-        let pdf = match self.sun_guide() {
+        let pdf = match self.sun_guide(guided) {
             Some((toward, lobe)) => {
                 SUN_GUIDE_PROBABILITY * lobe.eval(toward.dot(next))
                     + (1.0 - SUN_GUIDE_PROBABILITY) * own_pdf
@@ -217,9 +219,12 @@ impl<M: Medium> PathTracer<M> {
     /// about the sun. The sun lobe finds the bright aureole that the forward peak of cloud
     /// droplets makes around the sun in thin cloud, which the other sampling finds only rarely
     /// and then as a firefly; the throughput weight `f / (mixture pdf)` keeps it unbiased
-    /// (one-sample multiple importance sampling, Veach 1997, section 9.2.4).
-    fn continue_from(&self, vertex: Vertex, rng: &mut Rng) -> Continuation {
-        let guide = self.sun_guide();
+    /// (one-sample multiple importance sampling, Veach 1997, section 9.2.4). Only the first
+    /// [`SUN_GUIDED_EVENTS`] vertices of a path are `guided`: the weight `f / pdf` of the
+    /// mixture is up to `1 / (1 - p)` away from the sun, and over the hundreds of bounces of a
+    /// cloud path such factors would multiply into fireflies.
+    fn continue_from(&self, vertex: Vertex, guided: bool, rng: &mut Rng) -> Continuation {
+        let guide = self.sun_guide(guided);
         let dir = match (guide, vertex) {
             (Some((toward, lobe)), _) if rng.next_f32() < SUN_GUIDE_PROBABILITY => {
                 lobe.sample(toward, rng.next_vec3())
@@ -227,7 +232,7 @@ impl<M: Medium> PathTracer<M> {
             (_, Vertex::Medium { dir, .. }) => self.phase.sample(dir, rng.next_vec3()),
             (_, Vertex::Ground(g)) => crate::sampling::cosine_hemisphere(g.normal, rng.next_vec2()),
         };
-        let (value, pdf) = self.scattering(vertex, dir);
+        let (value, pdf) = self.scattering(vertex, guided, dir);
         let sky_pdf = match vertex {
             Vertex::Medium { position, .. } => self.environment.sky_pdf(position, dir),
             Vertex::Ground(_) => 0.0,
@@ -242,9 +247,13 @@ impl<M: Medium> PathTracer<M> {
 }
 
 /// Probability of drawing a continuation from the sun lobe instead of the vertex's own sampling.
-const SUN_GUIDE_PROBABILITY: f32 = 0.1;
-/// Asymmetry of the Henyey-Greenstein sun lobe: most of it within a few degrees of the sun.
-const SUN_GUIDE_G: f32 = 0.99;
+const SUN_GUIDE_PROBABILITY: f32 = 0.25;
+/// Vertices of a path (counted from the first) whose continuation is partly drawn from the sun lobe:
+/// the ground and the cloud surfaces first seen, where the aureole shows.
+const SUN_GUIDED_EVENTS: u32 = 2;
+/// Asymmetry of the Henyey-Greenstein sun lobe: half its peak within 0.36 degrees of the sun, the
+/// width of the sun disc blurred by the forward peak of 20 um droplets.
+const SUN_GUIDE_G: f32 = 0.992;
 
 /// Below this largest throughput component, paths play Russian roulette.
 const ROULETTE_THRESHOLD: f32 = 0.25;
