@@ -98,7 +98,10 @@ pub fn hdr_flip(
             &test.to_ldr(ev, Tonemap::Aces),
         )?
         .to_vec();
-        worst.iter_mut().zip(errors).for_each(|(w, e)| *w = w.max(e));
+        worst
+            .iter_mut()
+            .zip(errors)
+            .for_each(|(w, e)| *w = w.max(e));
     }
     let map = nv_flip::FlipImageFloat::with_data(reference.width, reference.height, &worst);
     Ok(summarise(&map))
@@ -150,7 +153,10 @@ mod tests {
         assert_eq!(same.mean, 0.0);
         let (slight, _) = hdr_flip(&reference, &scene(1.1)).unwrap();
         let (large, map) = hdr_flip(&reference, &scene(2.0)).unwrap();
-        assert!(slight.mean > 0.0 && large.mean > slight.mean, "{slight:?} {large:?}");
+        assert!(
+            slight.mean > 0.0 && large.mean > slight.mean,
+            "{slight:?} {large:?}"
+        );
         assert!(large.p99 >= large.p95 && large.p95 <= 1.0);
         assert_eq!((map.width, map.height), (48, 32));
         // A dark-region error invisible at the start exposure shows at the later ones.
