@@ -50,9 +50,7 @@ pub fn run(args: ReferenceArgs) -> Result<()> {
         size.x, size.y, args.spp, grid.x, grid.y, grid.z
     );
     let stop = interrupt_flag()?;
-    let deadline = args
-        .time_budget
-        .map(|s| Instant::now() + Duration::from_secs_f64(s.max(0.0)));
+    let deadline = args.time_budget.and_then(deadline_after);
     let should_stop =
         || stop.load(Ordering::Relaxed) || deadline.is_some_and(|d| Instant::now() >= d);
     let mut render = ProgressiveRender::new(&tracer, args.seed);
@@ -84,6 +82,13 @@ pub fn run(args: ReferenceArgs) -> Result<()> {
     eprintln!("wrote {}", args.out.display());
     stages.print();
     Ok(())
+}
+
+/// The moment `seconds` from now; None for a budget too large to represent (no limit). A
+/// negative or NaN budget is spent at once.
+pub fn deadline_after(seconds: f64) -> Option<Instant> {
+    let budget = Duration::try_from_secs_f64(seconds.max(0.0)).ok()?;
+    Instant::now().checked_add(budget)
 }
 
 /// A flag that Ctrl-C raises.

@@ -6,6 +6,7 @@
 
 use crate::common::{GpuArgs, SceneArgs};
 use crate::compare::Comparison;
+use crate::reference::deadline_after;
 use anyhow::{Context, Result, anyhow};
 use clap::Args;
 use cloudscape::field::VoxelGrid;
@@ -19,7 +20,7 @@ use glam::{UVec2, Vec3};
 use std::fmt::Write as _;
 use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// Arguments of `cloudscape report`.
 #[derive(Args, Debug)]
@@ -238,12 +239,12 @@ fn cached_reference(doc: &SceneDocument, args: &ReportArgs) -> Result<Reference>
         DEFAULT_MAJORANT_CELLS,
     )
     .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
-    let budget = Duration::from_secs_f64(args.time_budget / 2.0);
+
     let (mut samples, mut seconds) = (0u64, 0.0);
     let halves = [0u64, 1].map(|h| {
         let mut render = ProgressiveRender::new(&tracer, args.seed * 2 + h);
-        let deadline = Instant::now() + budget;
-        let stop = || Instant::now() >= deadline;
+        let deadline = deadline_after(args.time_budget / 2.0);
+        let stop = || deadline.is_some_and(|d| Instant::now() >= d);
         let mut done = 0;
         while done < args.spp / 2 && !stop() {
             render.run_pass(4.min(args.spp / 2 - done), &stop, &|_| {});
