@@ -5,7 +5,8 @@ use anyhow::{Result, anyhow};
 use clap::Args;
 use cloudscape::frame::Frame;
 use cloudscape::gpu::PassTimer;
-use cloudscape::renderer::{PASSES, SceneRenderer};
+use cloudscape::raymarch::temporal::TemporalSettings;
+use cloudscape::renderer::{PASSES, Reuse, SceneRenderer};
 use glam::UVec2;
 use serde::Serialize;
 
@@ -23,8 +24,21 @@ pub struct BenchArgs {
     /// Print the result as JSON on stdout.
     #[arg(long)]
     json: bool,
+    /// March one ray per N x N pixels per frame (1, 2 or 4) and reuse history between frames.
+    #[arg(long, value_name = "N", value_parser = parse_divisor)]
+    temporal: Option<u32>,
     #[command(flatten)]
     gpu: GpuArgs,
+}
+
+/// A march-grid divisor: 1, 2 or 4.
+fn parse_divisor(text: &str) -> Result<u32, String> {
+    match text.parse::<u32>() {
+        Ok(n @ (1 | 2 | 4)) => Ok(n),
+        _ => Err(format!(
+            "{text} is not a march-grid divisor; allowed 1, 2 or 4"
+        )),
+    }
 }
 
 /// Summary of one timed quantity over the frames, milliseconds.
@@ -56,8 +70,12 @@ struct Report {
     height: u32,
     frames: u32,
     timestamps: bool,
+    /// A CPU (software) adapter, whose timestamp queries do not measure shader execution.
+    software: bool,
     passes: Vec<Stat>,
     frame_wall: Stat,
+    /// Extinction evaluations along view rays per pixel (the last frame).
+    density_samples_per_pixel: f64,
 }
 
 /// Renders the scene's frame repeatedly, with the jitter advancing, and reports timings.
@@ -69,17 +87,26 @@ pub fn run(args: BenchArgs) -> Result<()> {
         .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
     let mut frame = Frame::from_scene(scene, UVec2::new(scene.render.width, scene.render.height));
     let mut timer = PassTimer::new(&ctx, PASSES.len() as u32);
+    let reuse = match args.temporal {
+        Some(divisor) => Reuse::Temporal(TemporalSettings {
+            divisor,
+            ..TemporalSettings::default()
+        }),
+        None => Reuse::None,
+    };
     let mut pass_ms: Vec<Vec<f64>> = vec![Vec::new(); PASSES.len()];
     let mut wall_ms = Vec::new();
     for i in 0..args.warmup + args.frames {
         frame.frame_index = i;
-        let wall = renderer.render_timed(&ctx, scene, &frame, &mut timer);
+        let wall = renderer.render_frame(&ctx, scene, &frame, reuse, &mut timer);
         if i < args.warmup {
             continue;
         }
         wall_ms.push(wall.as_secs_f64() * 1e3);
-        for ((_, ms), samples) in timer.read_ms(&ctx).into_iter().zip(&mut pass_ms) {
-            samples.push(ms);
+        for (label, ms) in timer.read_ms(&ctx) {
+            if let Some(k) = PASSES.iter().position(|p| *p == label) {
+                pass_ms[k].push(ms);
+            }
         }
     }
     let report = Report {
@@ -88,6 +115,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         height: frame.size.y,
         frames: args.frames,
         timestamps: ctx.has_timestamps(),
+        software: ctx.adapter_info().device_type == wgpu::DeviceType::Cpu,
         passes: PASSES
             .iter()
             .zip(pass_ms)
@@ -95,6 +123,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             .map(|(n, s)| Stat::new(n, s))
             .collect(),
         frame_wall: Stat::new("frame (wall)", wall_ms),
+        density_samples_per_pixel: renderer.march_stats(&ctx).density_samples_per_pixel,
     };
     print_report(&report, args.json)
 }
@@ -110,6 +139,10 @@ fn print_report(report: &Report, json: bool) -> Result<()> {
     );
     if !report.timestamps {
         println!("(this adapter has no timestamp queries: GPU time per pass is not available)");
+    } else if report.software {
+        println!(
+            "(a software adapter: its timestamps do not time shader execution; trust the wall time)"
+        );
     }
     println!(
         "{:<14} {:>10} {:>10} {:>10}",
@@ -121,5 +154,7 @@ fn print_report(report: &Report, json: bool) -> Result<()> {
             s.name, s.mean_ms, s.median_ms, s.min_ms
         );
     }
+    let samples = report.density_samples_per_pixel;
+    println!("view-ray density samples per pixel: {samples:.1}");
     Ok(())
 }

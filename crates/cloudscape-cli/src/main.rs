@@ -1,5 +1,6 @@
 //! `cloudscape`: render, export and benchmark cloud scenes from the command line.
 
+mod animate;
 mod bench;
 mod common;
 mod compare;
@@ -34,6 +35,9 @@ enum Command {
     /// Render the canonical scenes with the ray marcher and the path tracer, compare them, and
     /// write `docs/realism.md`.
     Report(report::ReportArgs),
+    /// Render a scene's frames over scene time (camera, sun and coverage paths, wind) to PNG or
+    /// EXR files, with an animated GIF preview (and an MP4 when ffmpeg is on PATH).
+    Animate(animate::AnimateArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -45,6 +49,7 @@ fn main() -> std::process::ExitCode {
         Command::Reference(args) => reference::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Report(args) => report::run(args),
+        Command::Animate(args) => animate::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

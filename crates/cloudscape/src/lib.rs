@@ -3,6 +3,7 @@
 //! One [`scene::Scene`] describes the sky; [`field::CloudField`] turns it into cloud density (the CPU
 //! specification that every GPU technique is tested against); each technique module renders it.
 
+pub mod animation;
 pub mod export;
 pub mod field;
 pub mod frame;

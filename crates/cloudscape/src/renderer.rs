@@ -9,7 +9,11 @@ use crate::gpu::timing::PassTimer;
 use crate::gpu::{GpuContext, readback};
 use crate::image::{HdrImage, LdrImage};
 use crate::post::{Background, DISPLAY_FORMAT, Display, HDR_FORMAT};
-use crate::raymarch::{CLOUD_FORMAT, MarchSettings, RaymarchRenderer, RaymarchTargets};
+use crate::raymarch::temporal::{TemporalMarch, TemporalSettings};
+use crate::raymarch::{
+    CLOUD_DEPTH_FORMAT, CLOUD_FORMAT, MarchGrid, MarchSettings, MarchStats, RaymarchRenderer,
+    RaymarchTargets,
+};
 use crate::scene::Scene;
 use glam::UVec2;
 use std::path::Path;
@@ -19,7 +23,16 @@ use std::time::{Duration, Instant};
 const TILE_ROWS: u32 = 32;
 
 /// Names of the GPU passes of one frame, in order.
-pub const PASSES: [&str; 3] = ["raymarch", "compose", "display"];
+pub const PASSES: [&str; 4] = ["raymarch", "temporal resolve", "compose", "display"];
+
+/// Whether a frame reuses earlier frames.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Reuse {
+    /// Every pixel marched afresh.
+    None,
+    /// A coarse march plus reprojected history.
+    Temporal(TemporalSettings),
+}
 
 /// The images of one render.
 pub struct Rendered {
@@ -34,6 +47,7 @@ struct Targets {
     size: UVec2,
     depth: wgpu::TextureView,
     clouds: wgpu::TextureView,
+    cloud_depth: wgpu::TextureView,
     hdr: wgpu::Texture,
     ldr: wgpu::Texture,
 }
@@ -68,6 +82,8 @@ impl Targets {
             size,
             depth: depth.create_view(&Default::default()),
             clouds: texture("clouds", CLOUD_FORMAT, storage).create_view(&Default::default()),
+            cloud_depth: texture("cloud depth", CLOUD_DEPTH_FORMAT, storage)
+                .create_view(&Default::default()),
             hdr: texture("hdr", HDR_FORMAT, storage),
             ldr: texture("ldr", DISPLAY_FORMAT, storage),
         }
@@ -102,6 +118,8 @@ pub struct SceneRenderer {
     background: Background,
     display: Display,
     targets: Option<Targets>,
+    temporal: Option<TemporalMarch>,
+    last_reuse: Reuse,
 }
 
 impl SceneRenderer {
@@ -123,12 +141,22 @@ impl SceneRenderer {
             background,
             display,
             targets: None,
+            temporal: None,
+            last_reuse: Reuse::None,
         })
     }
 
     /// The CPU field this renderer draws (the specification the GPU follows).
     pub fn field(&self) -> &CloudField {
         &self.field
+    }
+
+    /// What the ray marcher counted during the last render.
+    pub fn march_stats(&self, ctx: &GpuContext) -> MarchStats {
+        match (&self.temporal, self.last_reuse) {
+            (Some(t), Reuse::Temporal(_)) => t.stats(ctx),
+            _ => self.raymarch.stats(ctx),
+        }
     }
 
     /// The field's GPU resources.
@@ -153,6 +181,7 @@ impl SceneRenderer {
     ) -> Rendered {
         let size = UVec2::new(scene.render.width, scene.render.height);
         let frame = Frame::from_scene(scene, size);
+        self.last_reuse = Reuse::None;
         self.prepare(ctx, &frame, &MarchSettings::from_scene(scene));
         for row in (0..size.y).step_by(TILE_ROWS as usize) {
             let band = (
@@ -170,6 +199,7 @@ impl SceneRenderer {
             ctx,
             &mut encoder,
             &frame,
+            None,
             (scene.render.exposure_ev, scene.render.tonemap),
             None,
         );
@@ -178,28 +208,74 @@ impl SceneRenderer {
     }
 
     /// Renders one whole frame in a single submission and returns its wall time, with per-pass GPU
-    /// times in `timer` when the adapter has timestamp queries: the unit of `cloudscape bench`.
-    pub fn render_timed(
+    /// times in `timer` when the adapter has timestamp queries: the unit of `cloudscape bench` and
+    /// of sequences. With [`Reuse::Temporal`] the march runs on a coarse grid and a history carried
+    /// from frame to frame fills in the rest. Read the images with [`SceneRenderer::images`].
+    pub fn render_frame(
         &mut self,
         ctx: &GpuContext,
         scene: &Scene,
         frame: &Frame,
+        reuse: Reuse,
         timer: &mut PassTimer,
     ) -> Duration {
         let start = Instant::now();
         timer.reset();
-        self.prepare(ctx, frame, &MarchSettings::from_scene(scene));
+        self.last_reuse = reuse;
+        let settings = MarchSettings::from_scene(scene);
+        self.field_gpu.set_time(ctx, &self.field, frame.time_s);
+        self.targets(ctx, frame.size);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        self.encode_march(
-            ctx,
-            &mut encoder,
-            (UVec2::ZERO, frame.size),
-            timer.compute_pass_writes(PASSES[0]),
-        );
+        let clouds = match reuse {
+            Reuse::None => {
+                self.raymarch
+                    .prepare(ctx, frame, &settings, &MarchGrid::FULL);
+                self.encode_march(
+                    ctx,
+                    &mut encoder,
+                    (UVec2::ZERO, frame.size),
+                    timer.compute_pass_writes(PASSES[0]),
+                );
+                None
+            }
+            Reuse::Temporal(temporal) => {
+                if self
+                    .temporal
+                    .as_ref()
+                    .is_none_or(|t| *t.settings() != temporal)
+                {
+                    self.temporal = Some(TemporalMarch::new(ctx, &self.field_gpu, temporal));
+                }
+                let t = self.targets.as_ref().expect("targets were just made");
+                let march = self
+                    .temporal
+                    .as_mut()
+                    .expect("temporal march was just made");
+                let wind = self
+                    .field
+                    .layers
+                    .first()
+                    .map_or(glam::Vec2::ZERO, |l| l.wind_m_per_s);
+                let writes = timer.compute_pass_writes_pair(PASSES[0], PASSES[1]);
+                Some(
+                    march
+                        .encode(
+                            ctx,
+                            &mut encoder,
+                            &self.field_gpu,
+                            (frame, &settings, wind),
+                            &t.depth,
+                            writes,
+                        )
+                        .clone(),
+                )
+            }
+        };
         self.encode_post(
             ctx,
             &mut encoder,
             frame,
+            clouds.as_ref(),
             (scene.render.exposure_ev, scene.render.tonemap),
             Some(timer),
         );
@@ -209,10 +285,23 @@ impl SceneRenderer {
         start.elapsed()
     }
 
+    /// Forgets the temporal history (a camera cut; new weather).
+    pub fn reset_history(&mut self) {
+        if let Some(t) = self.temporal.as_mut() {
+            t.reset();
+        }
+    }
+
+    /// The images of the last frame rendered.
+    pub fn images(&self, ctx: &GpuContext) -> Rendered {
+        self.read_images(ctx)
+    }
+
     fn prepare(&mut self, ctx: &GpuContext, frame: &Frame, settings: &MarchSettings) {
         self.field_gpu.set_time(ctx, &self.field, frame.time_s);
         self.targets(ctx, frame.size);
-        self.raymarch.prepare(ctx, frame, settings);
+        self.raymarch
+            .prepare(ctx, frame, settings, &MarchGrid::FULL);
     }
 
     fn encode_march(
@@ -226,16 +315,20 @@ impl SceneRenderer {
         let targets = RaymarchTargets {
             depth: &t.depth,
             clouds: &t.clouds,
+            cloud_depth: &t.cloud_depth,
         };
         self.raymarch
             .encode(ctx, encoder, &self.field_gpu, &targets, band, writes);
     }
 
+    /// Composes `clouds` (the still march's target when None) over the background and maps it for
+    /// display.
     fn encode_post(
         &self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         frame: &Frame,
+        clouds: Option<&wgpu::TextureView>,
         display: (f32, crate::scene::Tonemap),
         mut timer: Option<&mut PassTimer>,
     ) {
@@ -244,16 +337,16 @@ impl SceneRenderer {
         let ldr = t.ldr.create_view(&Default::default());
         let writes = timer
             .as_deref_mut()
-            .and_then(|t| t.compute_pass_writes(PASSES[1]));
+            .and_then(|t| t.compute_pass_writes(PASSES[2]));
         self.background.encode(
             ctx,
             encoder,
             &self.field_gpu,
             frame,
-            (&t.clouds, &hdr),
+            (clouds.unwrap_or(&t.clouds), &hdr),
             writes,
         );
-        let writes = timer.and_then(|t| t.compute_pass_writes(PASSES[2]));
+        let writes = timer.and_then(|t| t.compute_pass_writes(PASSES[3]));
         self.display
             .encode(ctx, encoder, (&hdr, &ldr), frame.size, display, writes);
     }

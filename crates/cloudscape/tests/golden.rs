@@ -29,7 +29,8 @@ fn render(toml: &str, base_dir: &Path, overrides: &[&str]) -> LdrImage {
     let mut all: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     all.push(format!("render.width={}", SIZE[0]));
     all.push(format!("render.height={}", SIZE[1]));
-    let doc = SceneDocument::parse(toml, "golden scene", base_dir, &all).expect("golden scenes are valid");
+    let doc = SceneDocument::parse(toml, "golden scene", base_dir, &all)
+        .expect("golden scenes are valid");
     let ctx = GpuContext::for_tests();
     let mut renderer = SceneRenderer::new(&ctx, &doc.scene, base_dir).expect("field builds");
     renderer.render(&ctx, &doc.scene, |_| {}).ldr
@@ -37,20 +38,27 @@ fn render(toml: &str, base_dir: &Path, overrides: &[&str]) -> LdrImage {
 
 /// Compares `actual` with the golden `name`, or rewrites the golden when asked to.
 fn check(name: &str, actual: &LdrImage) {
-    let golden_path = manifest_dir().join("tests/golden").join(format!("{name}.png"));
+    let golden_path = manifest_dir()
+        .join("tests/golden")
+        .join(format!("{name}.png"));
     if std::env::var_os("CLOUDSCAPE_UPDATE_GOLDENS").is_some() {
         actual.write_png(&golden_path).expect("write golden");
         return;
     }
-    let golden = LdrImage::read_png(&golden_path)
-        .unwrap_or_else(|e| panic!("{e}: run with CLOUDSCAPE_UPDATE_GOLDENS=1 to create the golden"));
+    let golden = LdrImage::read_png(&golden_path).unwrap_or_else(|e| {
+        panic!("{e}: run with CLOUDSCAPE_UPDATE_GOLDENS=1 to create the golden")
+    });
     let (stats, difference) = flip(&golden, actual).expect("same size");
     eprintln!("{name}: FLIP mean {:.4}, p99 {:.4}", stats.mean, stats.p99);
     if stats.mean > MAX_MEAN || stats.p99 > MAX_P99 {
         let dir = manifest_dir().join("../../target/golden-failures");
         std::fs::create_dir_all(&dir).expect("failure directory");
-        actual.write_png(&dir.join(format!("{name}-actual.png"))).expect("write actual");
-        difference.write_png(&dir.join(format!("{name}-difference.png"))).expect("write difference");
+        actual
+            .write_png(&dir.join(format!("{name}-actual.png")))
+            .expect("write actual");
+        difference
+            .write_png(&dir.join(format!("{name}-difference.png")))
+            .expect("write difference");
         panic!(
             "{name}: FLIP mean {:.4} (max {MAX_MEAN}), p99 {:.4} (max {MAX_P99}); see {}",
             stats.mean,
@@ -62,18 +70,29 @@ fn check(name: &str, actual: &LdrImage) {
 
 #[test]
 fn cumulus_from_the_ground() {
-    check("cumulus_ground", &render("", Path::new("."), &["render.quality=medium"]));
+    check(
+        "cumulus_ground",
+        &render("", Path::new("."), &["render.quality=medium"]),
+    );
 }
 
 #[test]
 fn cumulus_layer_from_above() {
-    let view = ["camera.position_m=[0,6500,0]", "camera.pitch_deg=-35", "render.quality=medium"];
+    let view = [
+        "camera.position_m=[0,6500,0]",
+        "camera.pitch_deg=-35",
+        "render.quality=medium",
+    ];
     check("cumulus_above", &render("", Path::new("."), &view));
 }
 
 #[test]
 fn inside_the_layer() {
-    let view = ["camera.position_m=[4000,2300,-3000]", "camera.pitch_deg=3", "render.quality=medium"];
+    let view = [
+        "camera.position_m=[4000,2300,-3000]",
+        "camera.pitch_deg=3",
+        "render.quality=medium",
+    ];
     check("cumulus_inside", &render("", Path::new("."), &view));
 }
 
@@ -92,7 +111,14 @@ fn backlit_cumulus_at_sunset_has_silver_linings() {
 #[test]
 fn overcast_stratocumulus_on_a_flat_planet() {
     let toml = "[planet]\nshape = \"flat\"\n[[layers]]\ncoverage = 0.9\nthickness_m = 900.0\ntypes = { stratocumulus = 0.7, stratus = 0.3 }\n";
-    check("stratocumulus_flat", &render(toml, Path::new("."), &["camera.pitch_deg=20", "render.quality=medium"]));
+    check(
+        "stratocumulus_flat",
+        &render(
+            toml,
+            Path::new("."),
+            &["camera.pitch_deg=20", "render.quality=medium"],
+        ),
+    );
 }
 
 #[test]
@@ -100,8 +126,15 @@ fn voxel_grid_cloud_with_henyey_greenstein_and_agx() {
     let dir = std::env::temp_dir().join(format!("cloudscape-golden-voxel-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let grid = VoxelGrid::from_fn([32, 24, 32], Vec3::ZERO, Vec3::ONE, |p| {
-        let lobes = [(Vec3::new(0.5, 0.4, 0.5), 0.32), (Vec3::new(0.3, 0.55, 0.45), 0.2), (Vec3::new(0.7, 0.6, 0.55), 0.22)];
-        lobes.iter().map(|(c, r)| (1.0 - (p - *c).length() / r).clamp(0.0, 1.0)).fold(0.0, f32::max)
+        let lobes = [
+            (Vec3::new(0.5, 0.4, 0.5), 0.32),
+            (Vec3::new(0.3, 0.55, 0.45), 0.2),
+            (Vec3::new(0.7, 0.6, 0.55), 0.22),
+        ];
+        lobes
+            .iter()
+            .map(|(c, r)| (1.0 - (p - *c).length() / r).clamp(0.0, 1.0))
+            .fold(0.0, f32::max)
     });
     grid.write_vol(&dir.join("cloud.vol")).expect("write grid");
     let toml = "layers = []\n[phase]\nmodel = \"hg\"\ng = 0.85\n[render]\ntonemap = \"agx\"\nquality = \"medium\"\n\

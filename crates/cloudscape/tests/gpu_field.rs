@@ -9,7 +9,9 @@ use glam::Vec3;
 
 /// A deterministic point in the box [min, max].
 fn point(i: u32, min: Vec3, max: Vec3) -> Vec3 {
-    let u = |k: u32| cloudscape::field::noise::hash_to_unit(cloudscape::field::noise::pcg_hash(i * 3 + k));
+    let u = |k: u32| {
+        cloudscape::field::noise::hash_to_unit(cloudscape::field::noise::pcg_hash(i * 3 + k))
+    };
     min + (max - min) * Vec3::new(u(0), u(1), u(2))
 }
 
@@ -30,32 +32,64 @@ fn compare(scene: &Scene, base_dir: &std::path::Path, points: &[Vec3], time_s: f
     let gpu = FieldGpu::new(&ctx, &field);
     gpu.set_time(&ctx, &field, time_s);
     let gpu_values = gpu.probe(&ctx, points);
-    let cpu: Vec<f32> = points.iter().map(|p| field.extinction_per_m(*p, time_s)).collect();
-    let mut diffs: Vec<f32> = cpu.iter().zip(&gpu_values).map(|(c, g)| (c - g).abs()).collect();
+    let cpu: Vec<f32> = points
+        .iter()
+        .map(|p| field.extinction_per_m(*p, time_s))
+        .collect();
+    let mut diffs: Vec<f32> = cpu
+        .iter()
+        .zip(&gpu_values)
+        .map(|(c, g)| (c - g).abs())
+        .collect();
     diffs.sort_by(f32::total_cmp);
     let agreement = Agreement {
         worst: diffs[diffs.len() - 1],
         p99: diffs[diffs.len() * 99 / 100],
         cloudy: cpu.iter().filter(|c| **c > 0.0).count(),
     };
-    eprintln!("|gpu - cpu|: max {:e}, p99 {:e} m^-1 over {} points, {} in cloud", agreement.worst, agreement.p99, points.len(), agreement.cloudy);
+    eprintln!(
+        "|gpu - cpu|: max {:e}, p99 {:e} m^-1 over {} points, {} in cloud",
+        agreement.worst,
+        agreement.p99,
+        points.len(),
+        agreement.cloudy
+    );
     agreement
 }
 
 #[test]
 fn gpu_layer_density_equals_cpu_field() {
     let mut scene = Scene::default();
-    scene.layers[0].types = CloudTypeMix { cumulus: 0.6, cumulonimbus: 0.4, ..CloudTypeMix::default() };
+    scene.layers[0].types = CloudTypeMix {
+        cumulus: 0.6,
+        cumulonimbus: 0.4,
+        ..CloudTypeMix::default()
+    };
     scene.layers[0].coverage = 0.6;
     let layer = &scene.layers[0];
-    let (min, max) = (Vec3::new(-8000.0, layer.bottom_m, -8000.0), Vec3::new(8000.0, layer.bottom_m + layer.thickness_m, 8000.0));
+    let (min, max) = (
+        Vec3::new(-8000.0, layer.bottom_m, -8000.0),
+        Vec3::new(8000.0, layer.bottom_m + layer.thickness_m, 8000.0),
+    );
     let points: Vec<Vec3> = (0..3000).map(|i| point(i, min, max)).collect();
     let a = compare(&scene, std::path::Path::new("."), &points, 37.0);
-    assert!(a.cloudy > 600, "only {} of the points are in cloud: the comparison would prove little", a.cloudy);
+    assert!(
+        a.cloudy > 600,
+        "only {} of the points are in cloud: the comparison would prove little",
+        a.cloudy
+    );
     // Differences come only from the GPU's texture-filtering precision and float rounding, which the
     // coverage and erosion remaps amplify at a few points near thresholds.
-    assert!(a.p99 < 0.02 * layer.extinction_per_m, "99th percentile difference {} m^-1", a.p99);
-    assert!(a.worst < 0.15 * layer.extinction_per_m, "largest difference {} m^-1", a.worst);
+    assert!(
+        a.p99 < 0.02 * layer.extinction_per_m,
+        "99th percentile difference {} m^-1",
+        a.p99
+    );
+    assert!(
+        a.worst < 0.15 * layer.extinction_per_m,
+        "largest difference {} m^-1",
+        a.worst
+    );
 }
 
 #[test]
@@ -66,7 +100,10 @@ fn gpu_voxel_density_equals_cpu_field() {
         (1.0 - (p - Vec3::splat(0.5)).length() * 2.2).max(0.0) + 0.1 * (p.x * 20.0).sin().abs()
     });
     grid.write_vol(&dir.join("ball.vol")).expect("write .vol");
-    let mut scene = Scene { layers: Vec::new(), ..Scene::default() };
+    let mut scene = Scene {
+        layers: Vec::new(),
+        ..Scene::default()
+    };
     let volume = VolumeGrid {
         path: "ball.vol".into(),
         center_m: [100.0, 2000.0, -300.0],
@@ -75,10 +112,20 @@ fn gpu_voxel_density_equals_cpu_field() {
     };
     let min = Vec3::from_array(volume.center_m) - Vec3::from_array(volume.size_m) * 0.55;
     let max = Vec3::from_array(volume.center_m) + Vec3::from_array(volume.size_m) * 0.55;
-    scene.volumes = vec![volume.clone(), VolumeGrid { center_m: [3000.0, 2500.0, 0.0], ..volume }];
+    scene.volumes = vec![
+        volume.clone(),
+        VolumeGrid {
+            center_m: [3000.0, 2500.0, 0.0],
+            ..volume
+        },
+    ];
     let points: Vec<Vec3> = (0..2000).map(|i| point(i, min, max)).collect();
     let a = compare(&scene, &dir, &points, 0.0);
     std::fs::remove_dir_all(&dir).ok();
     assert!(a.cloudy > 500, "only {} points inside the grid", a.cloudy);
-    assert!(a.worst < 1e-4 * 0.08, "GPU and CPU grid extinction differ by {} m^-1", a.worst);
+    assert!(
+        a.worst < 1e-4 * 0.08,
+        "GPU and CPU grid extinction differ by {} m^-1",
+        a.worst
+    );
 }

@@ -5,7 +5,9 @@ use cloudscape::field::CloudField;
 use cloudscape::field::gpu::FieldGpu;
 use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, read_texture_rgba16f};
-use cloudscape::raymarch::{CLOUD_FORMAT, MarchSettings, RaymarchRenderer, RaymarchTargets};
+use cloudscape::raymarch::{
+    CLOUD_DEPTH_FORMAT, CLOUD_FORMAT, MarchGrid, MarchSettings, RaymarchRenderer, RaymarchTargets,
+};
 use cloudscape::scene::Scene;
 use glam::{UVec2, Vec4};
 
@@ -15,10 +17,19 @@ fn depth_at(frame: &Frame, distance_m: f32) -> f32 {
     clip.z / clip.w
 }
 
-fn texture(ctx: &GpuContext, size: UVec2, format: wgpu::TextureFormat, usage: wgpu::TextureUsages) -> wgpu::Texture {
+fn texture(
+    ctx: &GpuContext,
+    size: UVec2,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
     ctx.device.create_texture(&wgpu::TextureDescriptor {
         label: None,
-        size: wgpu::Extent3d { width: size.x, height: size.y, depth_or_array_layers: 1 },
+        size: wgpu::Extent3d {
+            width: size.x,
+            height: size.y,
+            depth_or_array_layers: 1,
+        },
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
@@ -40,9 +51,19 @@ fn march_over_depth(depth: f32) -> (f32, f32) {
     let field = CloudField::new(&scene, std::path::Path::new(".")).expect("field");
     let field_gpu = FieldGpu::new(&ctx, &field);
     let mut pass = RaymarchRenderer::new(&ctx, &field_gpu);
-    pass.prepare(&ctx, &frame, &MarchSettings::from_scene(&scene));
+    pass.prepare(
+        &ctx,
+        &frame,
+        &MarchSettings::from_scene(&scene),
+        &MarchGrid::FULL,
+    );
     use wgpu::TextureUsages as U;
-    let depth_texture = texture(&ctx, size, wgpu::TextureFormat::Depth32Float, U::TEXTURE_BINDING | U::RENDER_ATTACHMENT);
+    let depth_texture = texture(
+        &ctx,
+        size,
+        wgpu::TextureFormat::Depth32Float,
+        U::TEXTURE_BINDING | U::RENDER_ATTACHMENT,
+    );
     let clouds = texture(&ctx, size, CLOUD_FORMAT, U::STORAGE_BINDING | U::COPY_SRC);
     let depth_view = depth_texture.create_view(&Default::default());
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -51,13 +72,28 @@ fn march_over_depth(depth: f32) -> (f32, f32) {
         color_attachments: &[],
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: &depth_view,
-            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(depth), store: wgpu::StoreOp::Store }),
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(depth),
+                store: wgpu::StoreOp::Store,
+            }),
             stencil_ops: None,
         }),
         ..Default::default()
     });
-    let targets = RaymarchTargets { depth: &depth_view, clouds: &clouds.create_view(&Default::default()) };
-    pass.encode(&ctx, &mut encoder, &field_gpu, &targets, (UVec2::ZERO, size), None);
+    let targets = RaymarchTargets {
+        depth: &depth_view,
+        clouds: &clouds.create_view(&Default::default()),
+        cloud_depth: &texture(&ctx, size, CLOUD_DEPTH_FORMAT, U::STORAGE_BINDING)
+            .create_view(&Default::default()),
+    };
+    pass.encode(
+        &ctx,
+        &mut encoder,
+        &field_gpu,
+        &targets,
+        (UVec2::ZERO, size),
+        None,
+    );
     ctx.queue.submit([encoder.finish()]);
     let pixels = read_texture_rgba16f(&ctx, &clouds);
     let radiance: f32 = pixels.iter().map(|p| p[0] + p[1] + p[2]).sum();
@@ -74,5 +110,8 @@ fn geometry_in_front_of_the_layer_hides_the_clouds() {
     assert_eq!(radiance, 0.0);
     assert_eq!(transmittance, 1.0);
     let (radiance, transmittance) = march_over_depth(1.0);
-    assert!(radiance > 0.0 && transmittance < 0.8, "an empty depth buffer shows the clouds: T = {transmittance}");
+    assert!(
+        radiance > 0.0 && transmittance < 0.8,
+        "an empty depth buffer shows the clouds: T = {transmittance}"
+    );
 }

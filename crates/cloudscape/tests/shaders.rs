@@ -11,6 +11,7 @@ fn programs() -> Vec<(&'static str, String)> {
         ("raymarch", raymarch::shader_source()),
         ("compose", post::compose_source()),
         ("display", post::display_source()),
+        ("temporal resolve", raymarch::temporal::resolve_source()),
     ]
 }
 

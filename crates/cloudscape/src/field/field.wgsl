@@ -20,10 +20,11 @@ struct Field {
     planet: vec4<f32>,     // radius_m, 1 if flat, lowest layer bottom_m, highest layer top_m
     noise: vec4<f32>,      // base period m, detail period m, detail erosion, curl displacement m
     weather: vec4<f32>,    // weather extent x, z (m), time_s
-    counts: vec4<u32>,     // layer count, volume count
+    counts: vec4<u32>,     // layer count, volume count, hi-height level count
     atlas_size: vec4<f32>, // atlas texels xyz
     layers: array<FieldLayer, 4>,
     volumes: array<FieldVolume, 4>,
+    hiheight_levels: array<vec4<u32>, 16>, // per level: first cell, width, height
 }
 
 @group(0) @binding(0) var<uniform> field: Field;
@@ -34,6 +35,8 @@ struct Field {
 @group(0) @binding(5) var field_volume_atlas: texture_3d<f32>;
 @group(0) @binding(6) var field_repeat_linear: sampler;
 @group(0) @binding(7) var field_clamp_linear: sampler;
+// Hi-height pyramid cells, all levels back to back: per-layer highest cloud altitude (m).
+@group(0) @binding(8) var<storage, read> field_hiheight: array<vec4<f32>>;
 
 const FIELD_NO_HIT: f32 = 3.0e38;
 
@@ -100,7 +103,7 @@ fn field_height_gradient(type_coord: f32, f: f32) -> f32 {
     var gradients = array<vec4<f32>, 4>(
         vec4<f32>(0.0, 0.07, 0.08, 0.15),
         vec4<f32>(0.0, 0.2, 0.42, 0.6),
-        vec4<f32>(0.0, 0.08, 0.75, 1.0),
+        vec4<f32>(0.0, 0.1, 0.2, 1.0),
         vec4<f32>(0.0, 0.05, 0.9, 1.0),
     );
     let g = gradients[lo] * (1.0 - w) + gradients[lo + 1u] * w;
@@ -134,7 +137,7 @@ fn field_erode(density: f32, detail: vec4<f32>, f: f32, erosion: f32) -> f32 {
     return clamp(field_remap(density, modifier * erosion, 1.0, 0.0, 1.0), 0.0, 1.0);
 }
 
-fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32) -> f32 {
+fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32, eroded: bool) -> f32 {
     let f = (h - layer.shape.x) / layer.shape.y;
     if f < 0.0 || f > 1.0 {
         return 0.0;
@@ -159,6 +162,9 @@ fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32) -> f32 {
     if covered <= 0.0 {
         return 0.0;
     }
+    if !eroded {
+        return min(covered, 1.0) * w.z * layer.shape.w;
+    }
     let curl = textureSampleLevel(field_curl_noise, field_repeat_linear, q.xz / field.noise.x, 0.0);
     let swirl = (curl.xy * 2.0 - 1.0) * field.noise.w * (1.0 - f);
     let detail = textureSampleLevel(field_detail_noise, field_repeat_linear, (q + vec3<f32>(swirl.x, 0.0, swirl.y)) / field.noise.y, 0.0);
@@ -175,15 +181,24 @@ fn field_volume_extinction(v: FieldVolume, p: vec3<f32>) -> f32 {
     return textureSampleLevel(field_volume_atlas, field_clamp_linear, atlas_uvw, 0.0).x * v.min_m.w;
 }
 
-// Extinction sigma_t (m^-1) at world point p (m) at the field's time: CloudField::extinction_per_m.
-fn field_extinction(p: vec3<f32>) -> f32 {
+fn field_extinction_detail(p: vec3<f32>, eroded: bool) -> f32 {
     let h = field_altitude_m(p);
     var sigma_t = 0.0;
     for (var i = 0u; i < field.counts.x; i++) {
-        sigma_t += field_layer_extinction(field.layers[i], p, h);
+        sigma_t += field_layer_extinction(field.layers[i], p, h, eroded);
     }
     for (var i = 0u; i < field.counts.y; i++) {
         sigma_t += field_volume_extinction(field.volumes[i], p);
     }
     return sigma_t;
+}
+
+// Extinction sigma_t (m^-1) at world point p (m) at the field's time: CloudField::extinction_per_m.
+fn field_extinction(p: vec3<f32>) -> f32 {
+    return field_extinction_detail(p, true);
+}
+
+// The same without detail erosion: CloudField::coarse_extinction_per_m.
+fn field_extinction_coarse(p: vec3<f32>) -> f32 {
+    return field_extinction_detail(p, false);
 }

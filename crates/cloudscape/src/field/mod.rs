@@ -6,6 +6,7 @@
 //! Perlin-Worley base shape and Worley detail erosion, with curl noise displacing the detail.
 
 pub mod gpu;
+pub mod hiheight;
 mod layer;
 pub mod noise;
 pub mod profile;
@@ -60,6 +61,13 @@ impl PlacedVolume {
         }
         self.grid.sample(uvw) * self.extinction_per_m
     }
+}
+
+/// Whether detail noise erodes the density.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Detail {
+    Eroded,
+    Coarse,
 }
 
 /// Where the planet's ground is.
@@ -217,11 +225,21 @@ impl CloudField {
     /// Extinction coefficient sigma_t in m^-1 at world point `p` (metres) at scene time `time_s`:
     /// the sum over layers and voxel grids.
     pub fn extinction_per_m(&self, p: Vec3, time_s: f32) -> f32 {
+        self.extinction(p, time_s, Detail::Eroded)
+    }
+
+    /// Extinction without the detail erosion: the cheap density Schneider 2015 uses for light paths,
+    /// and an upper bound of [`CloudField::extinction_per_m`] (erosion only removes density).
+    pub fn coarse_extinction_per_m(&self, p: Vec3, time_s: f32) -> f32 {
+        self.extinction(p, time_s, Detail::Coarse)
+    }
+
+    fn extinction(&self, p: Vec3, time_s: f32, detail: Detail) -> f32 {
         let h = self.planet.altitude_m(p);
         let layers: f32 = self
             .layers
             .iter()
-            .map(|l| self.layer_extinction(l, p, h, time_s))
+            .map(|l| self.layer_extinction(l, p, h, time_s, detail))
             .sum();
         layers
             + self
@@ -243,7 +261,14 @@ impl CloudField {
     }
 
     /// One layer's extinction at `p`, altitude `h`. Each line has a twin in `field.wgsl`.
-    fn layer_extinction(&self, layer: &LayerField, p: Vec3, h: f32, time_s: f32) -> f32 {
+    fn layer_extinction(
+        &self,
+        layer: &LayerField,
+        p: Vec3,
+        h: f32,
+        time_s: f32,
+        detail: Detail,
+    ) -> f32 {
         let f = (h - layer.bottom_m) / layer.thickness_m;
         if !(0.0..=1.0).contains(&f) {
             return 0.0;
@@ -269,6 +294,9 @@ impl CloudField {
         let covered = layer::apply_coverage(shaped, coverage, type_coord, f);
         if covered <= 0.0 {
             return 0.0;
+        }
+        if detail == Detail::Coarse {
+            return covered.min(1.0) * w.z * layer.extinction_per_m;
         }
         let curl = self
             .curl

@@ -8,13 +8,15 @@ use super::noise::remap;
 use crate::scene::CloudTypeMix;
 
 /// Density-height gradients of the anchor types as (rise start, rise end, fall start, fall end),
-/// fractions of the layer thickness. Stratus, stratocumulus and cumulus are VolumeCloud's fallback
-/// gradients (peers.md, from yangrc1234/VolumeCloud); cumulonimbus fills the layer like Schneider
-/// 2015's towering type.
+/// fractions of the layer thickness. Stratus and stratocumulus are VolumeCloud's fallback gradients
+/// (peers.md, from yangrc1234/VolumeCloud). Cumulus rises as fast as VolumeCloud's but thins from 20 %
+/// of the layer to its top instead of holding full density to 75 %: thresholded by coverage, a long
+/// linear fall gives domed tops where a plateau gives flat-topped slabs (tuned by eye on the default
+/// scene). Cumulonimbus fills the layer like Schneider 2015's towering type.
 pub const TYPE_GRADIENTS: [[f32; 4]; 4] = [
     [0.0, 0.07, 0.08, 0.15],
     [0.0, 0.2, 0.42, 0.6],
-    [0.0, 0.08, 0.75, 1.0],
+    [0.0, 0.1, 0.2, 1.0],
     [0.0, 0.05, 0.9, 1.0],
 ];
 
@@ -102,7 +104,15 @@ mod tests {
     fn gradients_vanish_outside_their_band() {
         assert_eq!(height_gradient(0.0, 0.5), 0.0, "stratus stays low");
         assert!(height_gradient(0.0, 0.075) > 0.9);
-        assert!(height_gradient(2.0, 0.5) > 0.99, "cumulus fills the middle");
+        assert!(
+            height_gradient(2.0, 0.15) > 0.99,
+            "cumulus is densest low in the layer"
+        );
+        let dome = height_gradient(2.0, 0.6);
+        assert!(
+            dome > 0.3 && dome < 0.7,
+            "and thins gradually upward into domes: {dome}"
+        );
         assert_eq!(height_gradient(2.0, 1.0), 0.0);
         assert!(
             height_gradient(3.0, 0.95) > 0.4,

@@ -58,24 +58,40 @@ impl PassTimer {
         self.labels.clear();
     }
 
-    /// Timestamp writes for the next compute pass, recorded under `label`.
-    ///
-    /// `None` when the device has no timestamps or `capacity` passes were already timed this frame
-    /// (that pass then runs untimed).
+    /// Timestamp writes for the next compute pass, recorded under `label`; None when the adapter
+    /// lacks timestamps or the timer is full.
     pub fn compute_pass_writes(
         &mut self,
         label: &str,
     ) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        let queries = self.queries.as_ref()?;
+        let index = self.reserve(label)?;
+        self.queries.as_ref().map(|q| pass_writes(&q.set, index))
+    }
+
+    /// Timestamp writes for two passes encoded by one call (a pass and the pass that consumes it).
+    pub fn compute_pass_writes_pair(
+        &mut self,
+        first: &str,
+        second: &str,
+    ) -> [Option<wgpu::ComputePassTimestampWrites<'_>>; 2] {
+        let (a, b) = (self.reserve(first), self.reserve(second));
+        match self.queries.as_ref() {
+            Some(q) => [
+                a.map(|i| pass_writes(&q.set, i)),
+                b.map(|i| pass_writes(&q.set, i)),
+            ],
+            None => [None, None],
+        }
+    }
+
+    /// Claims the next pair of query slots for `label`.
+    fn reserve(&mut self, label: &str) -> Option<u32> {
+        self.queries.as_ref()?;
         let index = u32::try_from(self.labels.len())
             .ok()
             .filter(|&i| i < self.capacity)?;
         self.labels.push(label.to_string());
-        Some(wgpu::ComputePassTimestampWrites {
-            query_set: &queries.set,
-            beginning_of_pass_write_index: Some(2 * index),
-            end_of_pass_write_index: Some(2 * index + 1),
-        })
+        Some(index)
     }
 
     /// Copies this frame's timestamps into the readback buffer; encode after the last timed pass.
@@ -110,5 +126,14 @@ impl PassTimer {
                 (label.clone(), elapsed_ticks as f64 * ns_per_tick * 1e-6)
             })
             .collect()
+    }
+}
+
+/// The writes of query pair `index`: its beginning and end timestamps.
+fn pass_writes(set: &wgpu::QuerySet, index: u32) -> wgpu::ComputePassTimestampWrites<'_> {
+    wgpu::ComputePassTimestampWrites {
+        query_set: set,
+        beginning_of_pass_write_index: Some(2 * index),
+        end_of_pass_write_index: Some(2 * index + 1),
     }
 }

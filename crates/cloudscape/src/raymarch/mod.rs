@@ -13,10 +13,14 @@ use crate::scene::{Quality, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, UVec4, Vec4};
 
+pub mod temporal;
+
 const RAYMARCH_WGSL: &str = include_str!("raymarch.wgsl");
 
 /// Format of the cloud target: rgb in-scattered radiance, a transmittance.
 pub const CLOUD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Format of the cloud-depth target.
+pub const CLOUD_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// Source of the ray-march program.
 pub fn shader_source() -> String {
@@ -49,6 +53,8 @@ pub struct MarchSettings {
     pub ambient_scale: f32,
     /// Phase function.
     pub phase: PhaseLobes,
+    /// Skip empty space above the clouds with the hi-height pyramid (the image does not change).
+    pub empty_space_skipping: bool,
 }
 
 impl MarchSettings {
@@ -80,6 +86,7 @@ impl MarchSettings {
             albedo: l.albedo,
             ambient_scale: l.ambient_scale,
             phase: PhaseLobes::from_scene(&scene.phase),
+            empty_space_skipping: r.empty_space_skipping,
         }
     }
 }
@@ -92,14 +99,56 @@ struct MarchUniform {
     phase: Vec4,
     ambient: Vec4,
     tile: UVec4,
+    flags: UVec4,
+    grid: UVec4,
+    ray_offset: Vec4,
+}
+
+/// Which rays a march traces: one per pixel of a grid at 1/`divisor` of the frame's resolution,
+/// through sub-pixel `subpixel` of each block, offset along the ray by white noise (stills) or by a
+/// frame's Halton value plus the seed's Bayer pattern (temporal reuse).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MarchGrid {
+    /// 1, 2 or 4: the grid has 1/divisor of the frame's pixels along each axis.
+    pub divisor: u32,
+    /// The pixel of each divisor x divisor block the rays go through.
+    pub subpixel: UVec2,
+    /// Halton offset along the rays, for temporal reuse; None for independent white noise.
+    pub temporal_offset: Option<f32>,
+}
+
+impl MarchGrid {
+    /// Every pixel, white-noise offsets: stills.
+    pub const FULL: MarchGrid = MarchGrid {
+        divisor: 1,
+        subpixel: UVec2::ZERO,
+        temporal_offset: None,
+    };
+
+    /// Grid size for a frame of `size` pixels.
+    pub fn size(&self, size: UVec2) -> UVec2 {
+        (size + self.divisor - 1) / self.divisor
+    }
+}
+
+/// What the march did, counted on the GPU since the last [`RaymarchRenderer::prepare`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MarchStats {
+    /// Pixels marched.
+    pub pixels: u32,
+    /// Extinction evaluations along view rays, per marched pixel.
+    pub density_samples_per_pixel: f64,
 }
 
 /// Where the march reads and writes.
 pub struct RaymarchTargets<'a> {
     /// The host's depth buffer (Depth32Float, 0 near, 1 far, from `Frame::clip_from_view`).
     pub depth: &'a wgpu::TextureView,
-    /// Output, [`CLOUD_FORMAT`] with STORAGE_BINDING, the frame's size.
+    /// Output, [`CLOUD_FORMAT`] with STORAGE_BINDING, the march grid's size.
     pub clouds: &'a wgpu::TextureView,
+    /// Output, [`CLOUD_DEPTH_FORMAT`] with STORAGE_BINDING, the march grid's size: the
+    /// transmittance-weighted distance to the cloud in metres (0 where there is none).
+    pub cloud_depth: &'a wgpu::TextureView,
 }
 
 /// The ray-march pass.
@@ -108,8 +157,16 @@ pub struct RaymarchRenderer {
     layout: wgpu::BindGroupLayout,
     frame: wgpu::Buffer,
     march: wgpu::Buffer,
+    stats: wgpu::Buffer,
     settings: MarchUniform,
 }
+
+/// The counters' binding: a read-write storage buffer.
+const STATS: wgpu::BindingType = wgpu::BindingType::Buffer {
+    ty: wgpu::BufferBindingType::Storage { read_only: false },
+    has_dynamic_offset: false,
+    min_binding_size: None,
+};
 
 impl RaymarchRenderer {
     /// Builds the pipeline against the field's bind group layout.
@@ -122,7 +179,14 @@ impl RaymarchRenderer {
         let layout = bind_group_layout(
             &ctx.device,
             "raymarch",
-            &[UNIFORM, UNIFORM, depth, storage_texture_2d(CLOUD_FORMAT)],
+            &[
+                UNIFORM,
+                UNIFORM,
+                depth,
+                storage_texture_2d(CLOUD_FORMAT),
+                STATS,
+                storage_texture_2d(CLOUD_DEPTH_FORMAT),
+            ],
         );
         let pipeline = compute_pipeline(
             ctx,
@@ -147,12 +211,36 @@ impl RaymarchRenderer {
                 size_of::<crate::frame::FrameUniform>() as u64,
             ),
             march: buffer("raymarch settings", size_of::<MarchUniform>() as u64),
+            stats: ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("raymarch stats"),
+                size: 8,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
             settings: MarchUniform::zeroed(),
         }
     }
 
+    /// Reads back the counters of the work submitted since the last `prepare` (waits for it).
+    pub fn stats(&self, ctx: &GpuContext) -> MarchStats {
+        let counts = crate::gpu::read_buffer::<u32>(ctx, &self.stats);
+        let (samples, pixels) = (counts[0], counts[1]);
+        MarchStats {
+            pixels,
+            density_samples_per_pixel: samples as f64 / pixels.max(1) as f64,
+        }
+    }
+
     /// Uploads the frame and settings for the next [`RaymarchRenderer::encode`].
-    pub fn prepare(&mut self, ctx: &GpuContext, frame: &Frame, settings: &MarchSettings) {
+    pub fn prepare(
+        &mut self,
+        ctx: &GpuContext,
+        frame: &Frame,
+        settings: &MarchSettings,
+        grid: &MarchGrid,
+    ) {
         let [a, b, c] = settings.octave_factors;
         self.settings = MarchUniform {
             counts: UVec4::new(
@@ -170,7 +258,17 @@ impl RaymarchRenderer {
                 0.0,
             ),
             tile: UVec4::ZERO,
+            flags: UVec4::new(settings.empty_space_skipping as u32, 0, 0, 0),
+            grid: UVec4::new(
+                grid.divisor,
+                grid.subpixel.x,
+                grid.subpixel.y,
+                grid.temporal_offset.is_some() as u32,
+            ),
+            ray_offset: Vec4::new(grid.temporal_offset.unwrap_or(0.0), 0.0, 0.0, 0.0),
         };
+        ctx.queue
+            .write_buffer(&self.stats, 0, bytemuck::bytes_of(&[0u32; 2]));
         ctx.queue
             .write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame.uniform()));
         ctx.queue
@@ -202,6 +300,8 @@ impl RaymarchRenderer {
                 self.march.as_entire_binding(),
                 wgpu::BindingResource::TextureView(targets.depth),
                 wgpu::BindingResource::TextureView(targets.clouds),
+                self.stats.as_entire_binding(),
+                wgpu::BindingResource::TextureView(targets.cloud_depth),
             ],
         );
         dispatch_2d(

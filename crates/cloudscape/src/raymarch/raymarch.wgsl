@@ -6,7 +6,17 @@ struct March {
     octaves: vec4<f32>, // attenuation a, contribution b, eccentricity c, single-scattering albedo
     phase: vec4<f32>,   // phase lobes (optics::PhaseLobes::to_gpu)
     ambient: vec4<f32>, // ambient scale, phase mean cosine g
-    tile: vec4<u32>,    // origin of the pixel tile this dispatch covers
+        tile: vec4<u32>,    // origin of the pixel tile this dispatch covers
+    flags: vec4<u32>,   // 1 to skip empty space with the hi-height pyramid
+    grid: vec4<u32>,    // divisor of the march grid, sub-pixel x, y updated this frame, 1 if temporal
+    ray_offset: vec4<f32>, // this frame's Halton offset along the rays (temporal)
+}
+
+struct MarchResult {
+    radiance: vec3<f32>,
+    transmittance: f32,
+    density_samples: u32, // view-ray extinction evaluations
+    depth_m: f32,         // transmittance-weighted mean distance of the cloud, 0 without cloud
 }
 
 @group(1) @binding(0) var<uniform> frame: Frame;
@@ -14,6 +24,9 @@ struct March {
 // The host's depth buffer, bound as unfilterable float (GLSL cannot load from depth samplers).
 @group(1) @binding(2) var host_depth: texture_2d<f32>;
 @group(1) @binding(3) var cloud_out: texture_storage_2d<rgba16float, write>;
+// Counters over the dispatch: [0] view-ray density samples, [1] pixels marched.
+@group(1) @binding(4) var<storage, read_write> march_stats: array<atomic<u32>, 2>;
+@group(1) @binding(5) var cloud_depth_out: texture_storage_2d<r32float, write>;
 
 // Rays stop once this little light gets through (VolumeCloud's threshold, peers.md).
 const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
@@ -57,7 +70,8 @@ fn march_volume_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
     return hull;
 }
 
-// Optical depth toward the sun from p: `light_steps` segments whose lengths double, covering the way
+// Optical depth toward the sun from p, through the coarse (uneroded) density as Schneider 2015's
+// cheap light samples: `light_steps` segments whose lengths double, covering the way
 // to the top of the layers (at most MARCH_SUN_PATH_MAX_M), each sampled at a jittered point (VolumeCloud samples the
 // sun path at 0.5, 1.5, 3, 6, 12 units with weights 1, 1, 2, 4, 8; peers.md).
 fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
@@ -73,7 +87,7 @@ fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
     for (var k = 0u; k < n; k++) {
         let width = unit * f32(1u << k);
         let offset = fract(jitter + f32(k + 1u) * 0.618034); // decorrelated from the view jitter
-        tau += field_extinction(p + sun * (start + width * offset)) * width;
+        tau += field_extinction_coarse(p + sun * (start + width * offset)) * width;
         start += width;
     }
     return tau;
@@ -99,8 +113,8 @@ fn march_ambient(p: vec3<f32>, h: f32) -> vec3<f32> {
         above = field.planet.w - h;
         below = h - field.planet.z;
     }
-    let tau_up = field_extinction(p + up * (0.5 * above)) * above;
-    let tau_down = field_extinction(p - up * (0.5 * below)) * below;
+    let tau_up = field_extinction_coarse(p + up * (0.5 * above)) * above;
+    let tau_down = field_extinction_coarse(p - up * (0.5 * below)) * below;
     var ground = frame.ground_radiance.xyz;
     if frame.ground_albedo.w < 0.5 {
         ground = frame.sky_horizon.xyz;
@@ -143,19 +157,33 @@ fn march_step_count(length_m: f32) -> u32 {
 // Integrates [t0, t1] in `march_step_count` strata, one sample per stratum at fraction `jitter` of it,
 // with Hillaire 2016's energy-conserving step: S_int = (S - S exp(-sigma_t dt)) / sigma_t;
 // L += T S_int; T *= exp(-sigma_t dt).
-fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32) -> vec4<f32> {
+// `volume` is the stretch inside voxel-grid boxes, which the hi-height pyramid does not describe.
+fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volume: vec2<f32>) -> MarchResult {
     let n = march_step_count(t1 - t0);
     let cos_theta = dot(d, frame.sun_direction.xyz);
     let albedo = march.octaves.w;
     var radiance = vec3<f32>(0.0);
     var transmittance = 1.0;
     var depth_weighted = 0.0;
+    var samples = 0u;
+    var skip = vec2<f32>(t0, t0); // (empty until, query again at) from field_empty_until
+    let skipping = march.flags.x == 1u && field.counts.z > 0u;
     var t_start = t0;
     for (var i = 0u; i < n; i++) {
         let t_end = march_stratum_t(t0, t1, f32(i + 1u) / f32(n));
         let dt = t_end - t_start;
-        let p = o + d * (t_start + jitter * dt);
+                let t = t_start + jitter * dt;
+        let p = o + d * t;
         t_start = t_end;
+        if skipping && (t < volume.x || t > volume.y) {
+            if t >= skip.y {
+                skip = field_empty_until(o, d, t, t1);
+            }
+            if t < skip.x {
+                continue;
+            }
+        }
+        samples += 1u;
         let sigma_t = field_extinction(p);
         if sigma_t <= 0.0 {
             continue;
@@ -174,19 +202,52 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32) -> v
     // Aerial perspective at the transmittance-weighted mean cloud depth (Hillaire 2016, 5.9.1).
     let coverage = 1.0 - transmittance;
     let depth = select(0.0, depth_weighted / coverage, coverage > 0.0);
-    return vec4<f32>(frame_haze(frame, radiance, coverage, depth), transmittance);
+    return MarchResult(frame_haze(frame, radiance, coverage, depth), transmittance, samples, depth);
 }
 
+// The seed's 3x3 Bayer matrix (volumecloud-implementation-detail): per-pixel ray offsets in ninths.
+const MARCH_BAYER_3X3 = array<f32, 9>(0.0, 7.0, 3.0, 6.0, 5.0, 2.0, 4.0, 1.0, 8.0);
+
+// Offset of the samples along the ray, in strata: for stills, white noise per pixel; for temporal
+// reuse, the frame's Halton value plus the pixel's Bayer offset, fract(halton + bayer / 9), so that
+// each 3x3 neighbourhood spans the stratum (the seed's fix for AABB clipping of undersampled rays).
+fn march_ray_offset(px: vec2<u32>) -> f32 {
+    if march.grid.w == 0u {
+        return frame_pixel_jitter(px, u32(frame.viewport.w));
+    }
+    return fract(march.ray_offset.x + MARCH_BAYER_3X3[(px.x % 3u) * 3u + px.y % 3u] / 9.0);
+}
+
+// The farthest host depth over a block of the full-resolution depth buffer: a low-resolution ray
+// must not stop short of geometry that only part of its block has (Yusov 2014).
+fn march_block_depth(block: vec2<u32>, size: u32) -> f32 {
+    var depth = 0.0;
+    let full = vec2<u32>(frame.viewport.xy);
+    for (var y = 0u; y < size; y++) {
+        for (var x = 0u; x < size; x++) {
+            let texel = min(block * size + vec2<u32>(x, y), full - 1u);
+            depth = max(depth, textureLoad(host_depth, vec2<i32>(texel), 0).x);
+        }
+    }
+    return depth;
+}
+
+// One ray per pixel of the march grid (1/divisor of the frame's resolution), through the
+// sub-pixel of its block this frame updates; writes radiance and transmittance, and the
+// transmittance-weighted cloud distance (0 where there is no cloud).
 @compute @workgroup_size(8, 8)
 fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     let px = id.xy + march.tile.xy;
-    if px.x >= u32(frame.viewport.x) || px.y >= u32(frame.viewport.y) {
+    let divisor = march.grid.x;
+    let grid = (vec2<u32>(frame.viewport.xy) + divisor - 1u) / divisor;
+    if px.x >= grid.x || px.y >= grid.y {
         return;
     }
-    let pixel = vec2<f32>(px) + 0.5;
+    let full_px = min(px * divisor + march.grid.yz, vec2<u32>(frame.viewport.xy) - 1u);
+    let pixel = vec2<f32>(full_px) + 0.5;
     let o = frame.camera_position.xyz;
     let d = frame_ray_direction(frame, pixel);
-    let depth = textureLoad(host_depth, vec2<i32>(px), 0).x;
+    let depth = march_block_depth(px, divisor);
     var t_max = min(frame.camera_position.w, field_ground_distance(o, d, frame.ground_albedo.w > 0.5));
     if depth < 1.0 {
         t_max = min(t_max, frame_depth_distance(frame, pixel, depth));
@@ -196,15 +257,23 @@ fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     let t0 = min(select(FIELD_NO_HIT, layer.x, layer.x < layer.y), volume.x);
     let t1 = max(select(-FIELD_NO_HIT, layer.y, layer.x < layer.y), volume.y);
     var result = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    var cloud_depth = 0.0;
     if t0 < t1 {
-        // Samples of one pixel are stratified: offsets s / spp from one per-pixel jitter.
+        // Samples of one pixel are stratified: offsets s / spp from the pixel's ray offset.
         let spp = march.counts.z;
-        let pixel_jitter = frame_pixel_jitter(px, u32(frame.viewport.w));
+        let offset = march_ray_offset(px);
         var sum = vec4<f32>(0.0);
+        var samples = 0u;
         for (var s = 0u; s < spp; s++) {
-            sum += march_segment(o, d, t0, t1, fract(pixel_jitter + f32(s) / f32(spp)));
+            let m = march_segment(o, d, t0, t1, fract(offset + f32(s) / f32(spp)), volume);
+            sum += vec4<f32>(m.radiance, m.transmittance);
+            cloud_depth += m.depth_m / f32(spp);
+            samples += m.density_samples;
         }
         result = sum / f32(spp);
+        atomicAdd(&march_stats[0], samples);
     }
+    atomicAdd(&march_stats[1], 1u);
     textureStore(cloud_out, vec2<i32>(px), result);
+    textureStore(cloud_depth_out, vec2<i32>(px), vec4<f32>(cloud_depth, 0.0, 0.0, 0.0));
 }

@@ -37,6 +37,9 @@ pub struct Scene {
     pub lighting: Lighting,
     /// Image size, technique, quality, exposure and output.
     pub render: RenderSettings,
+    /// Keyframed camera, sun and coverage over scene time; empty (a static scene) by default.
+    #[serde(skip_serializing_if = "Animation::is_static")]
+    pub animation: Animation,
 }
 
 impl Default for Scene {
@@ -54,6 +57,7 @@ impl Default for Scene {
             phase: PhaseFunction::default(),
             lighting: Lighting::default(),
             render: RenderSettings::default(),
+            animation: Animation::default(),
         }
     }
 }
@@ -343,8 +347,8 @@ impl Default for NoiseSettings {
         NoiseSettings {
             seed: 3,
             base_period_m: 9000.0,
-            detail_period_m: 1200.0,
-            detail_erosion: 0.35,
+            detail_period_m: 700.0,
+            detail_erosion: 0.4,
             curl_displacement_m: 120.0,
         }
     }
@@ -499,6 +503,10 @@ pub struct RenderSettings {
     pub light_steps: Option<u32>,
     /// Overrides the preset's jittered passes averaged per pixel, 1..1024.
     pub samples_per_pixel: Option<u32>,
+    /// Skip the empty space above the clouds with the hierarchical height map (same image, less
+    /// work). Off by default: with more than one sample per pixel, grazing rays near the horizon
+    /// still show block artefacts on the software adapters (under investigation).
+    pub empty_space_skipping: bool,
     /// Exposure in stops (EV) applied before tone mapping, -20..20.
     pub exposure_ev: f32,
     /// Tone-mapping operator for PNG output.
@@ -519,10 +527,78 @@ impl Default for RenderSettings {
             primary_steps: None,
             light_steps: None,
             samples_per_pixel: None,
+            empty_space_skipping: false,
             exposure_ev: 0.0,
             tonemap: Tonemap::Aces,
             time_s: 0.0,
             output: "cloudscape.png".to_string(),
         }
     }
+}
+
+/// Changes over scene time, as keyframed paths (see [`crate::animation`]). Each path is either
+/// empty (that part of the scene stays as the rest of the scene says) or holds at least 2 keyframes
+/// with strictly increasing `time_s`. Before its first keyframe and after its last, a path holds.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Animation {
+    /// Camera keyframes: position, and orientation by look-at point or by yaw and pitch.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub camera_path: Vec<CameraKey>,
+    /// Sun keyframes: elevation and azimuth.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub time_of_day: Vec<SunKey>,
+    /// Keyframes of a factor on every layer's coverage: clouds grow (> 1) and decay (< 1).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub coverage_scale: Vec<CoverageKey>,
+}
+
+impl Animation {
+    /// Whether no path is given: the scene looks the same at every time but for the wind.
+    pub fn is_static(&self) -> bool {
+        self.camera_path.is_empty() && self.time_of_day.is_empty() && self.coverage_scale.is_empty()
+    }
+}
+
+/// One keyframe of the camera path.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraKey {
+    /// Scene time of the keyframe, seconds; later than the previous keyframe's.
+    pub time_s: f32,
+    /// Eye position in metres.
+    pub position_m: [f32; 3],
+    /// Point looked at, metres (not the eye position); either every keyframe has one or none has.
+    #[serde(default)]
+    pub look_at_m: Option<[f32; 3]>,
+    /// View azimuth in degrees clockwise from north, used without `look_at_m`; the camera turns the
+    /// short way round between keyframes.
+    #[serde(default)]
+    pub yaw_deg: f32,
+    /// View elevation in degrees above the horizon, -90..90, used without `look_at_m`.
+    #[serde(default)]
+    pub pitch_deg: f32,
+}
+
+/// One keyframe of the sun's path over the sky.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SunKey {
+    /// Scene time of the keyframe, seconds; later than the previous keyframe's.
+    pub time_s: f32,
+    /// Sun elevation above the horizon in degrees, -90..90.
+    pub sun_elevation_deg: f32,
+    /// Sun azimuth in degrees clockwise from north; less than 90 degrees of sky from the previous
+    /// keyframe's sun.
+    pub sun_azimuth_deg: f32,
+}
+
+/// One keyframe of the coverage factor.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoverageKey {
+    /// Scene time of the keyframe, seconds; later than the previous keyframe's.
+    pub time_s: f32,
+    /// Factor on every layer's `coverage`, >= 0; the product is clamped to 0..1.
+    pub scale: f32,
 }

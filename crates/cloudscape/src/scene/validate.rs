@@ -5,7 +5,7 @@
 
 use std::fmt;
 
-use super::model::{CloudLayer, Scene, VolumeGrid, WeatherSource};
+use super::model::{CameraKey, CloudLayer, CoverageKey, Scene, SunKey, VolumeGrid, WeatherSource};
 
 /// A value that breaks a rule, by dotted key path.
 #[derive(Debug)]
@@ -35,7 +35,23 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Violation> {
             VOLUME_RELATIONS,
         )?;
     }
-    Ok(())
+    validate_animation(scene)
+}
+
+/// Checks every keyframe of every animation path, then each path's order and consistency.
+fn validate_animation(scene: &Scene) -> Result<(), Violation> {
+    let animation = &scene.animation;
+    check_path(
+        &animation.camera_path,
+        "animation.camera_path",
+        &CAMERA_PATH,
+    )?;
+    check_path(&animation.time_of_day, "animation.time_of_day", &SUN_PATH)?;
+    check_path(
+        &animation.coverage_scale,
+        "animation.coverage_scale",
+        &COVERAGE_PATH,
+    )
 }
 
 /// The allowed values of a numeric field; every allowed value is also finite.
@@ -127,6 +143,46 @@ struct Relation<T> {
     broken: fn(&T) -> Option<String>,
 }
 
+/// A check between a keyframe and the one before it; `broken(previous, key)` returns the message.
+struct PairRelation<K> {
+    /// Dotted key path (relative to the later keyframe) of the field the message is about.
+    key: &'static str,
+    broken: fn(&K, &K) -> Option<String>,
+}
+
+/// Everything checked on the keyframes of one path type.
+struct PathRules<K: 'static> {
+    /// Rules of each keyframe's numeric fields.
+    rules: &'static [Rule<K>],
+    /// Checks within each keyframe.
+    relations: &'static [Relation<K>],
+    /// Checks between consecutive keyframes.
+    pairs: &'static [PairRelation<K>],
+}
+
+/// Keyframes with a scene time.
+trait Keyframe {
+    fn time_s(&self) -> f32;
+}
+
+impl Keyframe for CameraKey {
+    fn time_s(&self) -> f32 {
+        self.time_s
+    }
+}
+
+impl Keyframe for SunKey {
+    fn time_s(&self) -> f32 {
+        self.time_s
+    }
+}
+
+impl Keyframe for CoverageKey {
+    fn time_s(&self) -> f32 {
+        self.time_s
+    }
+}
+
 use Allowed::{Above, AtLeast, Between, Finite};
 use Field::{Float, Floats, Int};
 
@@ -199,6 +255,55 @@ const VOLUME_RULES: &[Rule<VolumeGrid>] = &[
 ];
 
 #[rustfmt::skip]
+const CAMERA_KEY_RULES: &[Rule<CameraKey>] = &[
+    rule("time_s", Finite, "s", |k| Float(k.time_s)),
+    rule("position_m", Finite, "m", |k| Floats(&k.position_m)),
+    rule("look_at_m", Finite, "m", |k| optional_floats(&k.look_at_m)),
+    rule("yaw_deg", Finite, "deg", |k| Float(k.yaw_deg)),
+    rule("pitch_deg", Between(-90.0, 90.0), "deg", |k| Float(k.pitch_deg)),
+];
+
+#[rustfmt::skip]
+const SUN_KEY_RULES: &[Rule<SunKey>] = &[
+    rule("time_s", Finite, "s", |k| Float(k.time_s)),
+    rule("sun_elevation_deg", Between(-90.0, 90.0), "deg", |k| Float(k.sun_elevation_deg)),
+    rule("sun_azimuth_deg", Finite, "deg", |k| Float(k.sun_azimuth_deg)),
+];
+
+#[rustfmt::skip]
+const COVERAGE_KEY_RULES: &[Rule<CoverageKey>] = &[
+    rule("time_s", Finite, "s", |k| Float(k.time_s)),
+    rule("scale", AtLeast(0.0), "", |k| Float(k.scale)),
+];
+
+#[rustfmt::skip]
+const CAMERA_PATH: PathRules<CameraKey> = PathRules {
+    rules: CAMERA_KEY_RULES,
+    relations: &[Relation { key: "look_at_m", broken: key_looks_at_its_eye }],
+    pairs: &[
+        PairRelation { key: "time_s", broken: time_not_increasing },
+        PairRelation { key: "look_at_m", broken: look_at_on_some_keys_only },
+    ],
+};
+
+#[rustfmt::skip]
+const SUN_PATH: PathRules<SunKey> = PathRules {
+    rules: SUN_KEY_RULES,
+    relations: &[],
+    pairs: &[
+        PairRelation { key: "time_s", broken: time_not_increasing },
+        PairRelation { key: "sun_azimuth_deg", broken: sun_keys_too_far_apart },
+    ],
+};
+
+#[rustfmt::skip]
+const COVERAGE_PATH: PathRules<CoverageKey> = PathRules {
+    rules: COVERAGE_KEY_RULES,
+    relations: &[],
+    pairs: &[PairRelation { key: "time_s", broken: time_not_increasing }],
+};
+
+#[rustfmt::skip]
 const SCENE_RELATIONS: &[Relation<Scene>] = &[
     Relation { key: "camera.far_m", broken: far_not_beyond_near },
     Relation { key: "camera.look_at_m", broken: look_at_is_the_eye },
@@ -262,6 +367,95 @@ fn volume_without_path(volume: &VolumeGrid) -> Option<String> {
     })
 }
 
+fn key_looks_at_its_eye(key: &CameraKey) -> Option<String> {
+    (key.look_at_m == Some(key.position_m))
+        .then(|| "look_at_m equals position_m, which gives no view direction; move it".to_string())
+}
+
+fn time_not_increasing<K: Keyframe>(previous: &K, key: &K) -> Option<String> {
+    let (before, now) = (previous.time_s(), key.time_s());
+    (now <= before).then(|| {
+        format!(
+            "{now} s is not after the previous keyframe's {before} s; times must strictly increase"
+        )
+    })
+}
+
+fn look_at_on_some_keys_only(previous: &CameraKey, key: &CameraKey) -> Option<String> {
+    let has = |k: &CameraKey| {
+        if k.look_at_m.is_some() {
+            "has"
+        } else {
+            "has no"
+        }
+    };
+    (previous.look_at_m.is_some() != key.look_at_m.is_some()).then(|| {
+        format!(
+            "this keyframe {} look_at_m but the previous one {}; give look_at_m on every keyframe of \
+             the path (targets follow their own spline) or on none (yaw_deg and pitch_deg are used)",
+            has(key),
+            has(previous)
+        )
+    })
+}
+
+/// Cosine of the angle on the sky between two sun keyframes, by the spherical law of cosines:
+/// `sin e1 sin e2 + cos e1 cos e2 cos(a1 - a2)`.
+fn cos_angle_between(a: &SunKey, b: &SunKey) -> f32 {
+    let (e1, e2) = (
+        a.sun_elevation_deg.to_radians(),
+        b.sun_elevation_deg.to_radians(),
+    );
+    let azimuth_difference = (a.sun_azimuth_deg - b.sun_azimuth_deg).to_radians();
+    e1.sin() * e2.sin() + e1.cos() * e2.cos() * azimuth_difference.cos()
+}
+
+/// Sun directions are interpolated as vectors (see `crate::animation`), which needs neighbours
+/// less than 90 degrees apart.
+fn sun_keys_too_far_apart(previous: &SunKey, key: &SunKey) -> Option<String> {
+    let angle_deg = cos_angle_between(previous, key)
+        .clamp(-1.0, 1.0)
+        .acos()
+        .to_degrees();
+    (angle_deg >= 90.0).then(|| {
+        format!(
+            "the sun moves {angle_deg:.1} deg across the sky from the previous keyframe; allowed \
+             < 90 deg: add a keyframe in between"
+        )
+    })
+}
+
+/// Checks every keyframe of `keys` (dotted path `path`), that there are none or at least 2, and
+/// the relations between consecutive keyframes.
+fn check_path<K: Keyframe>(keys: &[K], path: &str, rules: &PathRules<K>) -> Result<(), Violation> {
+    for (index, key) in keys.iter().enumerate() {
+        check(
+            key,
+            &format!("{path}.{index}."),
+            rules.rules,
+            rules.relations,
+        )?;
+    }
+    if keys.len() == 1 {
+        return Err(Violation {
+            key: path.to_string(),
+            message: "1 keyframe given; a path needs at least 2 (or none, for no change)"
+                .to_string(),
+        });
+    }
+    for (index, pair) in keys.windows(2).enumerate() {
+        for relation in rules.pairs {
+            if let Some(message) = (relation.broken)(&pair[0], &pair[1]) {
+                return Err(Violation {
+                    key: format!("{path}.{}.{}", index + 1, relation.key),
+                    message,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Runs the rules, then the relations, of one item whose keys start with `prefix`.
 fn check<T>(
     item: &T,
@@ -322,7 +516,29 @@ impl<T> Rule<T> {
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
-    use crate::scene::model::VolumeGrid;
+    use crate::scene::model::{Animation, VolumeGrid};
+
+    /// Two camera keyframes 10 s apart that look at a point, two sun and two coverage keyframes.
+    pub(in crate::scene) fn two_key_animation() -> Animation {
+        let camera = |time_s, x| CameraKey {
+            time_s,
+            position_m: [x, 30.0, 0.0],
+            look_at_m: Some([0.0, 2500.0, -6000.0]),
+            yaw_deg: 0.0,
+            pitch_deg: 0.0,
+        };
+        let sun = |time_s, sun_azimuth_deg| SunKey {
+            time_s,
+            sun_elevation_deg: 30.0,
+            sun_azimuth_deg,
+        };
+        let coverage = |time_s, scale| CoverageKey { time_s, scale };
+        Animation {
+            camera_path: vec![camera(0.0, 0.0), camera(10.0, 500.0)],
+            time_of_day: vec![sun(0.0, 215.0), sun(10.0, 220.0)],
+            coverage_scale: vec![coverage(0.0, 1.0), coverage(10.0, 1.2)],
+        }
+    }
 
     /// A scene with every optional field set and one volume, so serialising it names every key.
     pub(in crate::scene) fn fully_populated() -> Scene {
@@ -336,6 +552,7 @@ pub(super) mod tests {
             path: "cloud.vol".into(),
             ..VolumeGrid::default()
         });
+        scene.animation = two_key_animation();
         scene
     }
 
@@ -359,6 +576,11 @@ pub(super) mod tests {
         }
     }
 
+    /// The keys of `rules`, each after `prefix`.
+    fn prefixed<T>(prefix: &str, rules: &[Rule<T>]) -> Vec<String> {
+        rules.iter().map(|r| format!("{prefix}{}", r.key)).collect()
+    }
+
     #[test]
     fn every_numeric_field_except_seeds_has_exactly_one_rule() {
         let serialized = toml::Value::try_from(fully_populated()).unwrap();
@@ -367,10 +589,15 @@ pub(super) mod tests {
         fields.retain(|key| !key.ends_with("seed"));
         fields.sort();
         fields.dedup();
-        let scene_keys = SCENE_RULES.iter().map(|r| r.key.to_string());
-        let layer_keys = LAYER_RULES.iter().map(|r| format!("layers.{}", r.key));
-        let volume_keys = VOLUME_RULES.iter().map(|r| format!("volumes.{}", r.key));
-        let mut ruled: Vec<String> = scene_keys.chain(layer_keys).chain(volume_keys).collect();
+        let mut ruled: Vec<String> = [
+            prefixed("", SCENE_RULES),
+            prefixed("layers.", LAYER_RULES),
+            prefixed("volumes.", VOLUME_RULES),
+            prefixed("animation.camera_path.", CAMERA_KEY_RULES),
+            prefixed("animation.time_of_day.", SUN_KEY_RULES),
+            prefixed("animation.coverage_scale.", COVERAGE_KEY_RULES),
+        ]
+        .concat();
         ruled.sort();
         assert_eq!(ruled, fields);
     }
@@ -427,5 +654,85 @@ pub(super) mod tests {
             break_it(&mut scene);
             assert_eq!(validate(&scene).unwrap_err().key, key);
         }
+    }
+
+    /// The default scene with [`two_key_animation`].
+    fn animated_scene() -> Scene {
+        Scene {
+            animation: two_key_animation(),
+            ..Scene::default()
+        }
+    }
+
+    /// The violation of the default scene with `two_key_animation`, changed by `break_it`.
+    fn animation_violation(break_it: fn(&mut Animation)) -> Violation {
+        let mut scene = animated_scene();
+        break_it(&mut scene.animation);
+        validate(&scene).unwrap_err()
+    }
+
+    #[test]
+    fn keyframe_times_must_strictly_increase() {
+        let violation = animation_violation(|a| a.time_of_day[1].time_s = 0.0);
+        assert_eq!(violation.key, "animation.time_of_day.1.time_s");
+        assert_eq!(
+            violation.message,
+            "0 s is not after the previous keyframe's 0 s; times must strictly increase"
+        );
+        let violation = animation_violation(|a| a.camera_path[1].time_s = -1.0);
+        assert_eq!(violation.key, "animation.camera_path.1.time_s");
+    }
+
+    #[test]
+    fn a_path_of_one_keyframe_is_rejected_and_an_empty_one_allowed() {
+        let violation = animation_violation(|a| a.coverage_scale.truncate(1));
+        assert_eq!(violation.key, "animation.coverage_scale");
+        assert!(
+            violation.message.contains("at least 2"),
+            "{}",
+            violation.message
+        );
+        let mut scene = animated_scene();
+        scene.animation.coverage_scale.clear();
+        validate(&scene).unwrap();
+    }
+
+    #[test]
+    fn keyframe_fields_and_relations_are_checked_with_their_index() {
+        type Breaker = fn(&mut Animation);
+        let cases: [(Breaker, &str); 5] = [
+            (
+                |a| a.camera_path[1].pitch_deg = 91.0,
+                "animation.camera_path.1.pitch_deg",
+            ),
+            (
+                |a| a.coverage_scale[0].scale = -0.5,
+                "animation.coverage_scale.0.scale",
+            ),
+            (
+                |a| a.camera_path[1].look_at_m = None,
+                "animation.camera_path.1.look_at_m",
+            ),
+            (
+                |a| a.camera_path[0].look_at_m = Some(a.camera_path[0].position_m),
+                "animation.camera_path.0.look_at_m",
+            ),
+            (
+                |a| a.time_of_day[1].sun_azimuth_deg = 35.0,
+                "animation.time_of_day.1.sun_azimuth_deg",
+            ),
+        ];
+        for (break_it, key) in cases {
+            assert_eq!(animation_violation(break_it).key, key);
+        }
+    }
+
+    #[test]
+    fn sun_keyframes_just_under_90_degrees_apart_are_allowed() {
+        let mut scene = animated_scene();
+        scene.animation.time_of_day[0].sun_elevation_deg = 0.0;
+        scene.animation.time_of_day[1].sun_elevation_deg = 0.0;
+        scene.animation.time_of_day[1].sun_azimuth_deg = 215.0 + 89.5;
+        validate(&scene).unwrap();
     }
 }

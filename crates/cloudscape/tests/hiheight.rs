@@ -1,0 +1,66 @@
+//! Empty-space skipping with the hi-height pyramid changes the work, not the image.
+
+use cloudscape::gpu::GpuContext;
+use cloudscape::image::HdrImage;
+use cloudscape::renderer::SceneRenderer;
+use cloudscape::scene::SceneDocument;
+use std::path::Path;
+
+/// Renders the layer from `view` with skipping on or off; returns the image and the view-ray
+/// density samples per pixel.
+fn render(view: &[&str], skipping: bool) -> (HdrImage, f64) {
+    let mut overrides: Vec<String> = view.iter().map(|s| s.to_string()).collect();
+    overrides.extend(
+        [
+            "render.width=128",
+            "render.height=72",
+            "render.quality=medium",
+        ]
+        .map(String::from),
+    );
+    overrides.push(format!("render.empty_space_skipping={skipping}"));
+    let doc = SceneDocument::parse("", "hi-height test", Path::new("."), &overrides)
+        .expect("valid scene");
+    let ctx = GpuContext::for_tests();
+    let mut renderer = SceneRenderer::new(&ctx, &doc.scene, Path::new(".")).expect("field");
+    let image = renderer.render(&ctx, &doc.scene, |_| {}).hdr;
+    (image, renderer.march_stats(&ctx).density_samples_per_pixel)
+}
+
+fn largest_difference(a: &HdrImage, b: &HdrImage) -> f32 {
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs() / (q[c].abs() + 0.05)))
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn skipping_keeps_the_image_and_saves_samples_above_the_layer() {
+    let above = ["camera.position_m=[0,6500,0]", "camera.pitch_deg=-35"];
+    let (with, samples_with) = render(&above, true);
+    let (without, samples_without) = render(&above, false);
+    eprintln!(
+        "above the layer: {samples_without:.1} -> {samples_with:.1} density samples per pixel"
+    );
+    assert_eq!(
+        largest_difference(&with, &without),
+        0.0,
+        "the same strata are sampled: the image must not change"
+    );
+    assert!(
+        samples_with * 3.0 <= samples_without,
+        "{samples_without:.1} -> {samples_with:.1} samples per pixel"
+    );
+}
+
+#[test]
+fn skipping_keeps_the_image_from_the_ground() {
+    let (with, samples_with) = render(&[], true);
+    let (without, samples_without) = render(&[], false);
+    eprintln!(
+        "from the ground: {samples_without:.1} -> {samples_with:.1} density samples per pixel"
+    );
+    assert_eq!(largest_difference(&with, &without), 0.0);
+    assert!(samples_with <= samples_without);
+}
