@@ -366,7 +366,10 @@ fn markdown(rows: &[Row], args: &ReportArgs, adapter: &str) -> String {
          transmittance-weighted mean cloud depth. The path tracer's noise is dominated by the \
          forward peak of cloud droplets (approximate Mie, g = 0.995 for half the light): rare \
          paths that leave a cloud within a fraction of a degree of the sun carry most of the \
-         aureole, which shows as fireflies and as a large relative-MSE noise floor.\n",
+         aureole, which shows as fireflies and as a large relative-MSE noise floor. Where the sun \
+         is in frame its disc (radiance about 10^5) dominates the mean luminance: the path tracer \
+         spreads it over its pixel, the ray marcher draws it only where a pixel centre falls \
+         inside; HDR-FLIP is the robust number.\n",
         args.width, args.height, args.spp
     );
     let _ = writeln!(
