@@ -3,8 +3,11 @@
 mod animate;
 mod bench;
 mod common;
+mod compare;
 mod export;
+mod reference;
 mod render;
+mod report;
 
 use clap::{Parser, Subcommand};
 
@@ -25,6 +28,13 @@ enum Command {
     Export(export::ExportArgs),
     /// Time the GPU passes of a scene over many frames.
     Bench(bench::BenchArgs),
+    /// Path-trace a scene on the CPU: the ground truth the real-time techniques are measured by.
+    Reference(reference::ReferenceArgs),
+    /// Compare an image with a reference: HDR-FLIP, relative MSE, mean luminance ratio.
+    Compare(compare::CompareArgs),
+    /// Render the canonical scenes with the ray marcher and the path tracer, compare them, and
+    /// write `docs/realism.md`.
+    Report(report::ReportArgs),
     /// Render a scene's frames over scene time (camera, sun and coverage paths, wind) to PNG or
     /// EXR files, with an animated GIF preview (and an MP4 when ffmpeg is on PATH).
     Animate(animate::AnimateArgs),
@@ -36,6 +46,9 @@ fn main() -> std::process::ExitCode {
         Command::Render(args) => render::run(args),
         Command::Export(args) => export::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Reference(args) => reference::run(args),
+        Command::Compare(args) => compare::run(args),
+        Command::Report(args) => report::run(args),
         Command::Animate(args) => animate::run(args),
     };
     match result {

@@ -18,7 +18,7 @@ pub struct FlipStats {
 }
 
 /// Checks both images and that they have the same size.
-fn check_same_size(
+pub(super) fn check_same_size(
     reference: (u32, u32, usize),
     test: (u32, u32, usize),
 ) -> Result<(), ImageError> {
@@ -46,16 +46,29 @@ fn rgb_bytes(image: &LdrImage) -> Vec<u8> {
 /// implementation through the `nv-flip` crate) of `test` against `reference`, both sRGB; alpha is
 /// ignored. Returns the statistics and the error map coloured with the magma colour map.
 pub fn flip(reference: &LdrImage, test: &LdrImage) -> Result<(FlipStats, LdrImage), ImageError> {
+    Ok(summarise(&flip_error_map(reference, test)?))
+}
+
+/// The per-pixel LDR FLIP errors of `test` against `reference`, both sRGB.
+pub(super) fn flip_error_map(
+    reference: &LdrImage,
+    test: &LdrImage,
+) -> Result<nv_flip::FlipImageFloat, ImageError> {
     let size = |i: &LdrImage| (i.width, i.height, i.pixels.len());
     check_same_size(size(reference), size(test))?;
     let (width, height) = (reference.width, reference.height);
     let flip_image = |i: &LdrImage| nv_flip::FlipImageRgb8::with_data(width, height, &rgb_bytes(i));
-    let error = nv_flip::flip(
+    Ok(nv_flip::flip(
         flip_image(reference),
         flip_image(test),
         FLIP_PIXELS_PER_DEGREE,
-    );
-    let mut pool = nv_flip::FlipPool::from_image(&error);
+    ))
+}
+
+/// Statistics of a FLIP error map and the map coloured with the magma colour map.
+pub(super) fn summarise(error: &nv_flip::FlipImageFloat) -> (FlipStats, LdrImage) {
+    let (width, height) = (error.width(), error.height());
+    let mut pool = nv_flip::FlipPool::from_image(error);
     let stats = FlipStats {
         mean: pool.mean(),
         p95: pool.get_percentile(0.95, false),
@@ -66,14 +79,14 @@ pub fn flip(reference: &LdrImage, test: &LdrImage) -> Result<(FlipStats, LdrImag
         .chunks_exact(3)
         .map(|c| [c[0], c[1], c[2], u8::MAX])
         .collect();
-    Ok((
+    (
         stats,
         LdrImage {
             width,
             height,
             pixels,
         },
-    ))
+    )
 }
 
 /// Regulariser of the relative MSE denominator, in squared radiance units (physics.md).

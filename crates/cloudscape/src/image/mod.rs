@@ -1,12 +1,14 @@
 //! Images: linear HDR frames and sRGB display frames, their files (OpenEXR, PNG) and their
-//! comparison (FLIP, relative MSE).
+//! comparison (FLIP, HDR-FLIP, relative MSE).
 //!
 //! Pixels are stored row by row from the top-left corner.
 
 mod compare;
+mod hdr_flip;
 mod io;
 
 pub use compare::{FlipStats, flip, relative_mse};
+pub use hdr_flip::{ExposureRange, hdr_flip};
 pub use io::write_image;
 
 use std::path::PathBuf;

@@ -1,0 +1,173 @@
+//! Progressive rendering: passes of samples per pixel over all cores, accumulated per pixel with
+//! the statistics to tell how converged each pixel is; stoppable between rows.
+
+use crate::integrator::PathTracer;
+use crate::medium::Medium;
+use crate::rng::Rng;
+use cloudscape::image::HdrImage;
+use glam::{DVec3, Vec2};
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+/// Rec. 709 luminance weights of linear sRGB (ITU-R BT.709).
+const LUMINANCE: DVec3 = DVec3::new(0.2126, 0.7152, 0.0722);
+
+/// One pixel's running sums.
+#[derive(Clone, Copy, Debug, Default)]
+struct PixelSums {
+    samples: u32,
+    /// Sum of the RGB estimates.
+    sum: DVec3,
+    /// Sum of the squared luminance of the estimates.
+    sum_sq_luminance: f64,
+    /// Estimates dropped for not being finite (a bug if ever non-zero; counted, never hidden).
+    non_finite: u32,
+}
+
+/// A pixel's estimate and its uncertainty.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelEstimate {
+    /// Mean radiance over the samples.
+    pub mean: DVec3,
+    /// Samples taken.
+    pub samples: u32,
+    /// Estimated variance of the mean luminance (sample variance over the sample count).
+    pub luminance_variance_of_mean: f64,
+}
+
+/// Totals of a render so far.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderStats {
+    /// Camera samples taken (paths traced).
+    pub samples: u64,
+    /// Time spent tracing.
+    pub elapsed: Duration,
+    /// Samples whose estimate was not finite (and was dropped).
+    pub non_finite: u64,
+}
+
+impl RenderStats {
+    /// Camera samples (paths) per second of wall time.
+    pub fn samples_per_second(&self) -> f64 {
+        self.samples as f64 / self.elapsed.as_secs_f64().max(1e-9)
+    }
+}
+
+/// A progressive render of one path tracer and seed.
+pub struct ProgressiveRender<'a, M> {
+    tracer: &'a PathTracer<M>,
+    seed: u64,
+    width: usize,
+    pixels: Vec<PixelSums>,
+    next_sample: u32,
+    elapsed: Duration,
+}
+
+impl<'a, M: Medium> ProgressiveRender<'a, M> {
+    /// An empty render of `tracer`'s frame; `seed` picks the random numbers (the same seed gives
+    /// the same image, whatever the passes and the thread count).
+    pub fn new(tracer: &'a PathTracer<M>, seed: u64) -> Self {
+        let size = tracer.frame.size;
+        ProgressiveRender {
+            tracer,
+            seed,
+            width: size.x as usize,
+            pixels: vec![PixelSums::default(); size.x as usize * size.y as usize],
+            next_sample: 0,
+            elapsed: Duration::ZERO,
+        }
+    }
+
+    /// Adds `spp` samples to every pixel, rows in parallel. `stop` is asked before each row: once
+    /// it says yes, the remaining rows of the pass are skipped (their pixels keep fewer samples).
+    /// `row_done` is told how many samples each finished row added. Returns whether the pass
+    /// completed.
+    pub fn run_pass(
+        &mut self,
+        spp: u32,
+        stop: &(dyn Fn() -> bool + Sync),
+        row_done: &(dyn Fn(u64) + Sync),
+    ) -> bool {
+        let start = Instant::now();
+        let (first, width, seed, tracer) = (self.next_sample, self.width, self.seed, self.tracer);
+        let complete = self
+            .pixels
+            .par_chunks_mut(width)
+            .enumerate()
+            .map(|(y, row)| {
+                if stop() {
+                    return false;
+                }
+                for (x, pixel) in row.iter_mut().enumerate() {
+                    let index = (y * width + x) as u64;
+                    for s in first..first + spp {
+                        let mut rng = Rng::for_sample(seed, index, u64::from(s));
+                        let point = Vec2::new(x as f32, y as f32) + rng.next_vec2();
+                        pixel.add(tracer.radiance(point, &mut rng).as_dvec3());
+                    }
+                }
+                row_done(u64::from(spp) * width as u64);
+                true
+            })
+            .reduce(|| true, |a, b| a && b);
+        self.next_sample += spp;
+        self.elapsed += start.elapsed();
+        complete
+    }
+
+    /// The image so far: each pixel's mean (black where no sample was taken), alpha 1.
+    pub fn image(&self) -> HdrImage {
+        let size = self.tracer.frame.size;
+        let pixels = self
+            .pixels
+            .iter()
+            .map(|p| {
+                let m = p.sum / f64::from(p.samples.max(1));
+                [m.x as f32, m.y as f32, m.z as f32, 1.0]
+            })
+            .collect();
+        HdrImage {
+            width: size.x,
+            height: size.y,
+            pixels,
+        }
+    }
+
+    /// The estimate of pixel `(x, y)`.
+    pub fn pixel(&self, x: u32, y: u32) -> PixelEstimate {
+        self.pixels[y as usize * self.width + x as usize].estimate()
+    }
+
+    /// Totals so far.
+    pub fn stats(&self) -> RenderStats {
+        RenderStats {
+            samples: self.pixels.iter().map(|p| u64::from(p.samples)).sum(),
+            elapsed: self.elapsed,
+            non_finite: self.pixels.iter().map(|p| u64::from(p.non_finite)).sum(),
+        }
+    }
+}
+
+impl PixelSums {
+    fn add(&mut self, radiance: DVec3) {
+        if !radiance.is_finite() {
+            self.non_finite += 1;
+            return;
+        }
+        self.samples += 1;
+        self.sum += radiance;
+        self.sum_sq_luminance += radiance.dot(LUMINANCE).powi(2);
+    }
+
+    fn estimate(&self) -> PixelEstimate {
+        let n = f64::from(self.samples.max(1));
+        let mean = self.sum / n;
+        let mean_luminance = mean.dot(LUMINANCE);
+        let variance = (self.sum_sq_luminance / n - mean_luminance * mean_luminance).max(0.0);
+        PixelEstimate {
+            mean,
+            samples: self.samples,
+            luminance_variance_of_mean: variance * n / (n - 1.0).max(1.0) / n,
+        }
+    }
+}
