@@ -23,20 +23,7 @@ fn texture(
     format: wgpu::TextureFormat,
     usage: wgpu::TextureUsages,
 ) -> wgpu::Texture {
-    ctx.device.create_texture(&wgpu::TextureDescriptor {
-        label: None,
-        size: wgpu::Extent3d {
-            width: size.x,
-            height: size.y,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage,
-        view_formats: &[],
-    })
+    cloudscape::gpu::pipeline::texture_2d(ctx, "host depth test", size, format, usage)
 }
 
 /// Marches the default scene over a depth buffer cleared to `depth`; returns (rgb radiance sum,
