@@ -8,7 +8,7 @@ use crate::frame::{FRAME_WGSL, Frame};
 use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{
     UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d, float_texture,
-    storage_texture_2d,
+    storage_texture_2d, uniform_buffer,
 };
 use crate::scene::Tonemap;
 use wgpu::util::DeviceExt;
@@ -54,12 +54,11 @@ impl Background {
             "compose_background",
             &[field.layout(), &layout],
         );
-        let frame = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("compose frame"),
-            size: size_of::<crate::frame::FrameUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let frame = uniform_buffer(
+            ctx,
+            "compose frame",
+            size_of::<crate::frame::FrameUniform>() as u64,
+        );
         Background {
             pipeline,
             layout,

@@ -7,6 +7,7 @@ use crate::frame::{FRAME_WGSL, Frame};
 use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{
     UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d, storage_texture_2d,
+    uniform_buffer,
 };
 use crate::optics::{PHASE_WGSL, PhaseLobes};
 use crate::scene::{Quality, Scene};
@@ -195,14 +196,7 @@ impl RaymarchRenderer {
             "march_clouds",
             &[field.layout(), &layout],
         );
-        let buffer = |label, size| {
-            ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
+        let buffer = |label, size| uniform_buffer(ctx, label, size);
         RaymarchRenderer {
             pipeline,
             layout,

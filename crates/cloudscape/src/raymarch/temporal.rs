@@ -10,7 +10,7 @@ use crate::frame::{FRAME_WGSL, Frame};
 use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{
     STORAGE_OUTPUT, UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d,
-    float_texture, storage_texture_2d, texture_2d,
+    float_texture, storage_texture_2d, texture_2d, uniform_buffer,
 };
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
@@ -156,14 +156,7 @@ impl TemporalMarch {
             "resolve_clouds",
             &[&layout],
         );
-        let buffer = |label, size| {
-            ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
+        let buffer = |label, size| uniform_buffer(ctx, label, size);
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
