@@ -4,7 +4,7 @@
 use super::hiheight::HiHeight;
 use super::{CloudField, MAX_LAYERS, MAX_VOLUMES, NoiseKind};
 use crate::gpu::pipeline::{
-    UNIFORM, bind_group, bind_group_layout, compute_pipeline, float_texture,
+    UNIFORM, bind_group, bind_group_layout, compute_pipeline, float_texture, storage_binding,
 };
 use crate::gpu::{GpuContext, readback};
 use bytemuck::{Pod, Zeroable};
@@ -265,12 +265,11 @@ impl FieldGpu {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let storage = |read_only| wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        };
-        let layout = bind_group_layout(device, "probe", &[storage(true), storage(false)]);
+        let layout = bind_group_layout(
+            device,
+            "probe",
+            &[storage_binding(true), storage_binding(false)],
+        );
         let pipeline = compute_pipeline(
             ctx,
             "field probe",
@@ -299,11 +298,7 @@ impl FieldGpu {
 fn field_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     use wgpu::TextureViewDimension::{D2, D3};
     let sampler = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
-    let pyramid = wgpu::BindingType::Buffer {
-        ty: wgpu::BufferBindingType::Storage { read_only: true },
-        has_dynamic_offset: false,
-        min_binding_size: None,
-    };
+    let pyramid = storage_binding(true);
     let types = [
         UNIFORM,
         float_texture(D3),
@@ -431,12 +426,11 @@ fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
-    let storage = wgpu::BindingType::Buffer {
-        ty: wgpu::BufferBindingType::Storage { read_only: false },
-        has_dynamic_offset: false,
-        min_binding_size: None,
-    };
-    let layout = bind_group_layout(device, "noise generator", &[UNIFORM, storage]);
+    let layout = bind_group_layout(
+        device,
+        "noise generator",
+        &[UNIFORM, storage_binding(false)],
+    );
     let pipeline = compute_pipeline(
         ctx,
         "noise generator",

@@ -42,6 +42,28 @@ pub fn uniform_buffer(ctx: &GpuContext, label: &str, size: u64) -> wgpu::Buffer 
     })
 }
 
+/// A storage buffer of `size` bytes, zeroed, that passes read and write and that can be copied
+/// to and from.
+pub fn storage_buffer(ctx: &GpuContext, label: &str, size: u64) -> wgpu::Buffer {
+    ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    })
+}
+
+/// A storage buffer binding, read-only or read-write.
+pub const fn storage_binding(read_only: bool) -> wgpu::BindingType {
+    wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Storage { read_only },
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    }
+}
+
 /// A uniform buffer binding.
 pub const UNIFORM: wgpu::BindingType = wgpu::BindingType::Buffer {
     ty: wgpu::BufferBindingType::Uniform,
@@ -152,6 +174,19 @@ pub fn dispatch_2d(
     size: glam::UVec2,
     timestamps: Option<wgpu::ComputePassTimestampWrites>,
 ) {
+    dispatch_2d_repeated(encoder, label, pipeline, groups, (size, 1), timestamps);
+}
+
+/// [`dispatch_2d`] `times` times in one pass; each dispatch sees the storage writes of the one
+/// before (wgpu orders dispatches that share a read-write resource).
+pub fn dispatch_2d_repeated(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::ComputePipeline,
+    groups: &[&wgpu::BindGroup],
+    (size, times): (glam::UVec2, u32),
+    timestamps: Option<wgpu::ComputePassTimestampWrites>,
+) {
     let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
         label: Some(label),
         timestamp_writes: timestamps,
@@ -160,5 +195,7 @@ pub fn dispatch_2d(
     for (i, g) in groups.iter().enumerate() {
         pass.set_bind_group(i as u32, *g, &[]);
     }
-    pass.dispatch_workgroups(size.x.div_ceil(8), size.y.div_ceil(8), 1);
+    for _ in 0..times {
+        pass.dispatch_workgroups(size.x.div_ceil(8), size.y.div_ceil(8), 1);
+    }
 }

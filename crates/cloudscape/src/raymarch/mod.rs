@@ -6,8 +6,8 @@ use crate::field::gpu::{FIELD_WGSL, FieldGpu, NOISE_WGSL};
 use crate::frame::{FRAME_WGSL, Frame};
 use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{
-    UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d, storage_texture_2d,
-    uniform_buffer,
+    UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d_repeated,
+    storage_binding, storage_buffer, storage_texture_2d, uniform_buffer,
 };
 use crate::optics::{PHASE_WGSL, PhaseLobes};
 use crate::scene::{Quality, Scene};
@@ -159,15 +159,15 @@ pub struct RaymarchRenderer {
     frame: wgpu::Buffer,
     march: wgpu::Buffer,
     stats: wgpu::Buffer,
+    sums: wgpu::Buffer,
     settings: MarchUniform,
 }
 
-/// The counters' binding: a read-write storage buffer.
-const STATS: wgpu::BindingType = wgpu::BindingType::Buffer {
-    ty: wgpu::BufferBindingType::Storage { read_only: false },
-    has_dynamic_offset: false,
-    min_binding_size: None,
-};
+/// Bytes of one pixel's running sums (`MarchSum` in raymarch.wgsl).
+const MARCH_SUM_BYTES: u64 = 32;
+
+/// The counters' and sums' binding.
+const READ_WRITE: wgpu::BindingType = storage_binding(false);
 
 impl RaymarchRenderer {
     /// Builds the pipeline against the field's bind group layout.
@@ -185,8 +185,9 @@ impl RaymarchRenderer {
                 UNIFORM,
                 depth,
                 storage_texture_2d(CLOUD_FORMAT),
-                STATS,
+                READ_WRITE,
                 storage_texture_2d(CLOUD_DEPTH_FORMAT),
+                READ_WRITE,
             ],
         );
         let pipeline = compute_pipeline(
@@ -205,14 +206,8 @@ impl RaymarchRenderer {
                 size_of::<crate::frame::FrameUniform>() as u64,
             ),
             march: buffer("raymarch settings", size_of::<MarchUniform>() as u64),
-            stats: ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("raymarch stats"),
-                size: 8,
-                usage: wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::COPY_DST
-                    | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }),
+            stats: storage_buffer(ctx, "raymarch stats", 8),
+            sums: storage_buffer(ctx, "raymarch sums", MARCH_SUM_BYTES),
             settings: MarchUniform::zeroed(),
         }
     }
@@ -270,8 +265,9 @@ impl RaymarchRenderer {
     }
 
     /// Records the march over the pixel rectangle at `origin` of `size` pixels (the whole frame, or
-    /// one tile of it so long renders can report progress between submissions). A tile's origin is
-    /// uploaded now, so submit each tile before encoding the next.
+    /// one tile of it so long renders can report progress between submissions), one dispatch per
+    /// sample per pixel. A tile's origin is uploaded now, so submit each tile before encoding the
+    /// next.
     pub fn encode(
         &mut self,
         ctx: &GpuContext,
@@ -281,10 +277,16 @@ impl RaymarchRenderer {
         (origin, size): (UVec2, UVec2),
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) {
-        if self.settings.tile.truncate().truncate() != origin {
-            self.settings.tile = origin.extend(0).extend(0);
+        let tile = UVec4::new(origin.x, origin.y, size.x, 0);
+        if self.settings.tile != tile {
+            self.settings.tile = tile;
             ctx.queue
                 .write_buffer(&self.march, 0, bytemuck::bytes_of(&self.settings));
+        }
+        let samples = self.settings.counts.z;
+        let sums_bytes = MARCH_SUM_BYTES * u64::from(size.x * size.y);
+        if samples > 1 && self.sums.size() < sums_bytes {
+            self.sums = storage_buffer(ctx, "raymarch sums", sums_bytes);
         }
         let group = bind_group(
             &ctx.device,
@@ -296,14 +298,15 @@ impl RaymarchRenderer {
                 wgpu::BindingResource::TextureView(targets.clouds),
                 self.stats.as_entire_binding(),
                 wgpu::BindingResource::TextureView(targets.cloud_depth),
+                self.sums.as_entire_binding(),
             ],
         );
-        dispatch_2d(
+        dispatch_2d_repeated(
             encoder,
             "raymarch",
             &self.pipeline,
             &[field.bind_group(), &group],
-            size,
+            (size, samples),
             timestamps,
         );
     }

@@ -6,7 +6,7 @@ struct March {
     octaves: vec4<f32>, // attenuation a, contribution b, eccentricity c, single-scattering albedo
     phase: vec4<f32>,   // phase lobes (optics::PhaseLobes::to_gpu)
     ambient: vec4<f32>, // ambient scale, phase mean cosine g
-        tile: vec4<u32>,    // origin of the pixel tile this dispatch covers
+    tile: vec4<u32>,    // origin x, y of the pixel tile this dispatch covers, its width
     flags: vec4<u32>,   // 1 to skip empty space with the hi-height pyramid
     grid: vec4<u32>,    // divisor of the march grid, sub-pixel x, y updated this frame, 1 if temporal
     ray_offset: vec4<f32>, // this frame's Halton offset along the rays (temporal)
@@ -27,6 +27,8 @@ struct MarchResult {
 // Counters over the dispatch: [0] view-ray density samples, [1] pixels marched.
 @group(1) @binding(4) var<storage, read_write> march_stats: array<atomic<u32>, 2>;
 @group(1) @binding(5) var cloud_depth_out: texture_storage_2d<r32float, write>;
+// Per-pixel sums over the samples of a multi-sample pass (MarchSum, declared with march_clouds).
+@group(1) @binding(6) var<storage, read_write> march_sums: array<MarchSum>;
 
 // Rays stop once this little light gets through (VolumeCloud's threshold, peers.md).
 const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
@@ -232,9 +234,20 @@ fn march_block_depth(block: vec2<u32>, size: u32) -> f32 {
     return depth;
 }
 
-// One ray per pixel of the march grid (1/divisor of the frame's resolution), through the
-// sub-pixel of its block this frame updates; writes radiance and transmittance, and the
-// transmittance-weighted cloud distance (0 where there is no cloud).
+// Running sums of one pixel's samples while the pass is dispatched once per sample.
+struct MarchSum {
+    radiance_transmittance: vec4<f32>,
+    depth_m: f32,
+    samples: u32, // samples summed so far
+}
+
+// One sample of one ray per pixel of the march grid (1/divisor of the frame's resolution), through
+// the sub-pixel of its block this frame updates. With several samples per pixel the pass is
+// dispatched once per sample and sums them in `march_sums`: llvmpipe caps the loop iterations of
+// one invocation at 65535 in total (LP_MAX_TGSI_LOOP_ITERATIONS, Mesa gallivm), which long grazing
+// rays times several samples exceed, and short invocations suit GPUs as well. The last sample writes
+// radiance and transmittance, and the transmittance-weighted cloud distance (0 where there is no
+// cloud).
 @compute @workgroup_size(8, 8)
 fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     let px = id.xy + march.tile.xy;
@@ -252,6 +265,12 @@ fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     if depth < 1.0 {
         t_max = min(t_max, frame_depth_distance(frame, pixel, depth));
     }
+    let spp = march.counts.z;
+    let slot = id.y * march.tile.z + id.x;
+    var sample_index = 0u;
+    if spp > 1u {
+        sample_index = march_sums[slot].samples;
+    }
     let layer = march_layer_interval(o, d, t_max);
     let volume = march_volume_interval(o, d, t_max);
     let t0 = min(select(FIELD_NO_HIT, layer.x, layer.x < layer.y), volume.x);
@@ -260,18 +279,21 @@ fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     var cloud_depth = 0.0;
     if t0 < t1 {
         // Samples of one pixel are stratified: offsets s / spp from the pixel's ray offset.
-        let spp = march.counts.z;
-        let offset = march_ray_offset(px);
-        var sum = vec4<f32>(0.0);
-        var samples = 0u;
-        for (var s = 0u; s < spp; s++) {
-            let m = march_segment(o, d, t0, t1, fract(offset + f32(s) / f32(spp)), volume);
-            sum += vec4<f32>(m.radiance, m.transmittance);
-            cloud_depth += m.depth_m / f32(spp);
-            samples += m.density_samples;
+        let jitter = fract(march_ray_offset(px) + f32(sample_index) / f32(spp));
+        let m = march_segment(o, d, t0, t1, jitter, volume);
+        result = vec4<f32>(m.radiance, m.transmittance);
+        cloud_depth = m.depth_m;
+        atomicAdd(&march_stats[0], m.density_samples);
+    }
+    if spp > 1u {
+        let sum = march_sums[slot];
+        if sample_index + 1u < spp {
+            march_sums[slot] = MarchSum(sum.radiance_transmittance + result, sum.depth_m + cloud_depth, sample_index + 1u);
+            return;
         }
-        result = sum / f32(spp);
-        atomicAdd(&march_stats[0], samples);
+        march_sums[slot] = MarchSum(vec4<f32>(0.0), 0.0, 0u); // ready for the next pass
+        result = (sum.radiance_transmittance + result) / f32(spp);
+        cloud_depth = (sum.depth_m + cloud_depth) / f32(spp);
     }
     atomicAdd(&march_stats[1], 1u);
     textureStore(cloud_out, vec2<i32>(px), result);

@@ -504,8 +504,7 @@ pub struct RenderSettings {
     /// Overrides the preset's jittered passes averaged per pixel, 1..1024.
     pub samples_per_pixel: Option<u32>,
     /// Skip the empty space above the clouds with the hierarchical height map (same image, less
-    /// work). Off by default: with more than one sample per pixel, grazing rays near the horizon
-    /// still show block artefacts on the software adapters (under investigation).
+    /// work). On by default.
     pub empty_space_skipping: bool,
     /// Exposure in stops (EV) applied before tone mapping, -20..20.
     pub exposure_ev: f32,
@@ -527,7 +526,7 @@ impl Default for RenderSettings {
             primary_steps: None,
             light_steps: None,
             samples_per_pixel: None,
-            empty_space_skipping: false,
+            empty_space_skipping: true,
             exposure_ev: 0.0,
             tonemap: Tonemap::Aces,
             time_s: 0.0,
