@@ -1,53 +1,14 @@
-//! End-to-end tests of `cloudscape animate`: the real binary in a scratch directory, rendering a
-//! few tiny frames. Like the other GPU tests they honour `CLOUDSCAPE_TEST_BACKEND`.
+//! `cloudscape animate`: frame sequences, the GIF preview, and rejected arguments.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Command;
 
-use cloudscape::gpu::context::TEST_BACKEND_ENV;
+use crate::support::{Run, Scratch, TINY, cloudscape};
 use cloudscape::image::{HdrImage, LdrImage};
 
-/// Arguments that keep frames small and fast.
-const TINY: [&str; 6] = [
-    "--width",
-    "64",
-    "--height",
-    "36",
-    "--set",
-    "render.quality=low",
-];
-
-/// An empty directory for one test, removed when dropped.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(test: &str) -> Scratch {
-        let name = format!("cloudscape-animate-{test}-{}", std::process::id());
-        let dir = std::env::temp_dir().join(name);
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("create scratch dir");
-        Scratch(dir)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-/// Runs `cloudscape animate args...` in `dir`, on the test backend when one is set.
-fn animate(dir: &Path, args: &[&str]) -> Output {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_cloudscape"));
-    command.current_dir(dir).arg("animate").args(args);
-    if let Some(backend) = std::env::var_os(TEST_BACKEND_ENV) {
-        command.arg("--backend").arg(backend);
-    }
-    command.output().expect("start the cloudscape binary")
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
+/// Runs `cloudscape animate args...` in `dir`.
+fn animate(dir: &Path, args: &[&str]) -> Run {
+    cloudscape(dir, &[&["animate"], args].concat(), true)
 }
 
 fn flythrough() -> String {
@@ -76,14 +37,14 @@ fn animate_writes_the_frames_and_a_gif_of_them() {
     let mut args = vec![flythrough()];
     args.extend(["--frames", "3", "--fps", "2", "--out", "anim"].map(String::from));
     args.extend(TINY.map(String::from));
-    let output = animate(
-        &scratch.0,
+    let run = animate(
+        scratch.path(),
         &args.iter().map(String::as_str).collect::<Vec<_>>(),
     );
-    let messages = stderr(&output);
-    assert!(output.status.success(), "{messages}");
+    let messages = run.stderr;
+    assert!(run.success, "{messages}");
     assert!(messages.contains("wrote anim/preview.gif"), "{messages}");
-    let dir = scratch.0.join("anim");
+    let dir = scratch.join("anim");
     let frames: Vec<LdrImage> = (0..3)
         .map(|i| LdrImage::read_png(&dir.join(format!("frame_{i:04}.png"))).expect("a frame"))
         .collect();
@@ -107,11 +68,11 @@ fn animate_writes_exr_and_rebuilds_the_field_when_clouds_grow() {
     ];
     args.extend(TINY);
     args.extend(["--set", growth, "--set", "camera.pitch_deg=30"]);
-    let output = animate(&scratch.0, &args);
-    let messages = stderr(&output);
-    assert!(output.status.success(), "{messages}");
+    let run = animate(scratch.path(), &args);
+    let messages = run.stderr;
+    assert!(run.success, "{messages}");
     assert!(messages.contains("rebuilt for 1 of 2 frames"), "{messages}");
-    let read = |i: u32| HdrImage::read(&scratch.0.join(format!("anim/frame_{i:04}.exr")));
+    let read = |i: u32| HdrImage::read(&scratch.join(&format!("anim/frame_{i:04}.exr")));
     let (sparse, dense) = (read(0).expect("frame 0"), read(1).expect("frame 1"));
     // Clouds are grey-white, the sky behind them blue: more cloud, more red for the blue.
     let redness = |image: &HdrImage| {
@@ -125,12 +86,12 @@ fn animate_writes_exr_and_rebuilds_the_field_when_clouds_grow() {
 #[test]
 fn a_static_scene_needs_a_frame_count() {
     let scratch = Scratch::new("static");
-    let output = animate(&scratch.0, &["--out", "anim"]);
-    let messages = stderr(&output);
-    assert!(!output.status.success());
+    let run = animate(scratch.path(), &["--out", "anim"]);
+    let messages = run.stderr;
+    assert!(!run.success);
     assert!(messages.contains("give --frames N"), "{messages}");
     assert!(
-        !scratch.0.join("anim").exists(),
+        !scratch.join("anim").exists(),
         "a rejected run made the directory"
     );
 }
@@ -138,11 +99,11 @@ fn a_static_scene_needs_a_frame_count() {
 #[test]
 fn the_frame_rate_must_be_positive() {
     let scratch = Scratch::new("fps");
-    let output = animate(
-        &scratch.0,
+    let run = animate(
+        scratch.path(),
         &["--frames", "2", "--fps", "0", "--out", "anim"],
     );
-    let messages = stderr(&output);
-    assert!(!output.status.success());
+    let messages = run.stderr;
+    assert!(!run.success);
     assert!(messages.contains("allowed > 0"), "{messages}");
 }

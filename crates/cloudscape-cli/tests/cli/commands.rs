@@ -1,83 +1,11 @@
-//! End-to-end tests of the `cloudscape` binary: each runs the real executable in a fresh scratch
-//! directory and checks its exit status, its messages and the files it writes (or must not write).
-//!
-//! GPU work stays tiny (64x36 pixels, low quality). Like the library's GPU tests, these honour
-//! `CLOUDSCAPE_TEST_BACKEND` (`vulkan` or `gl`) and fail, never skip, when no adapter exists.
+//! `render`, `export` and `bench`: what they write, and how they reject bad input.
 
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
+use crate::support::{Run, Scratch, TINY, cloudscape};
 use cloudscape::field::VoxelGrid;
-use cloudscape::gpu::context::TEST_BACKEND_ENV;
 use cloudscape::image::{HdrImage, LdrImage};
-
-/// Arguments that keep a render small and fast.
-const TINY: [&str; 6] = [
-    "--width",
-    "64",
-    "--height",
-    "36",
-    "--set",
-    "render.quality=low",
-];
-
-/// A scratch directory unique to one test of this process, removed when dropped.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    /// An empty directory `cloudscape-cli-{test}-{process id}` in the system's temporary directory.
-    fn new(test: &str) -> Scratch {
-        let dir =
-            std::env::temp_dir().join(format!("cloudscape-cli-{test}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("create scratch dir");
-        Scratch(dir)
-    }
-
-    /// The path of `name` inside the directory.
-    fn join(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-
-    /// The names of the files and directories in the directory.
-    fn file_names(&self) -> BTreeSet<String> {
-        let entries = std::fs::read_dir(&self.0).expect("list scratch dir");
-        entries
-            .map(|entry| entry.expect("read scratch dir entry").file_name())
-            .map(|name| name.to_string_lossy().into_owned())
-            .collect()
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-/// What one run of the binary did.
-struct Run {
-    success: bool,
-    stdout: String,
-    stderr: String,
-}
-
-/// Runs `cloudscape args...` in `dir`, with `--backend` from `CLOUDSCAPE_TEST_BACKEND` when set
-/// and `gpu` is true (only `render` and `bench` take it).
-fn cloudscape(dir: &Path, args: &[&str], gpu: bool) -> Run {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_cloudscape"));
-    command.current_dir(dir).args(args);
-    if let Some(backend) = std::env::var_os(TEST_BACKEND_ENV).filter(|_| gpu) {
-        command.arg("--backend").arg(backend);
-    }
-    let output = command.output().expect("start the cloudscape binary");
-    Run {
-        success: output.status.success(),
-        stdout: String::from_utf8_lossy(&output.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&output.stderr).into_owned(),
-    }
-}
 
 /// `cloudscape render [scene] TINY --out out`.
 fn render(dir: &Path, scene: Option<&str>, out: &str) -> Run {
@@ -108,7 +36,7 @@ fn assert_rejected(scratch: &Scratch, before: &[&str], run: &Run, expected: &[&s
 fn assert_scene_rejected(test: &str, toml: &str, expected: &[&str]) {
     let scratch = Scratch::new(test);
     std::fs::write(scratch.join("scene.toml"), toml).expect("write scene file");
-    let run = render(&scratch.0, Some("scene.toml"), "out.png");
+    let run = render(scratch.path(), Some("scene.toml"), "out.png");
     assert_rejected(&scratch, &["scene.toml"], &run, expected);
 }
 
@@ -116,14 +44,14 @@ fn assert_scene_rejected(test: &str, toml: &str, expected: &[&str]) {
 /// piece of `expected` in the message and no file written.
 fn assert_args_rejected(test: &str, args: &[&str], gpu: bool, expected: &[&str]) {
     let scratch = Scratch::new(test);
-    let run = cloudscape(&scratch.0, args, gpu);
+    let run = cloudscape(scratch.path(), args, gpu);
     assert_rejected(&scratch, &[], &run, expected);
 }
 
 #[test]
 fn render_writes_a_png_of_the_requested_size() {
     let scratch = Scratch::new("render-png");
-    let run = render(&scratch.0, None, "out.png");
+    let run = render(scratch.path(), None, "out.png");
     assert!(run.success, "{}", run.stderr);
     assert!(run.stderr.contains("adapter: "), "{}", run.stderr);
     assert!(run.stderr.contains("wrote out.png"), "{}", run.stderr);
@@ -138,7 +66,7 @@ fn render_writes_a_png_of_the_requested_size() {
 #[test]
 fn render_exr_holds_finite_non_negative_radiance() {
     let scratch = Scratch::new("render-exr");
-    let run = render(&scratch.0, None, "out.exr");
+    let run = render(scratch.path(), None, "out.exr");
     assert!(run.success, "{}", run.stderr);
     let hdr = HdrImage::read(&scratch.join("out.exr")).expect("read the EXR");
     assert_eq!((hdr.width, hdr.height), (64, 36));
@@ -200,7 +128,7 @@ fn missing_backend_says_what_to_install() {
 fn export_writes_a_mitsuba_scene_and_a_readable_grid() {
     let scratch = Scratch::new("export");
     let args = ["export", "--resolution", "16", "--out", "mitsuba"];
-    let run = cloudscape(&scratch.0, &args, false);
+    let run = cloudscape(scratch.path(), &args, false);
     assert!(run.success, "{}", run.stderr);
     let xml = std::fs::read_to_string(scratch.join("mitsuba/scene.xml")).expect("read scene.xml");
     assert!(
@@ -217,7 +145,7 @@ fn bench_json_reports_each_pass_and_the_frame_wall_time() {
     let scratch = Scratch::new("bench");
     let mut args = vec!["bench", "--frames", "2", "--warmup", "0", "--json"];
     args.extend(TINY);
-    let run = cloudscape(&scratch.0, &args, true);
+    let run = cloudscape(scratch.path(), &args, true);
     assert!(run.success, "{}", run.stderr);
     let report: serde_json::Value = serde_json::from_str(&run.stdout).expect("JSON on stdout");
     assert_eq!(report["frames"], 2);
