@@ -167,16 +167,19 @@ pub fn worley_fbm(uvw: Vec3, cells: i32, seed: u32) -> f32 {
 }
 
 /// Three Perlin octaves at `cells`, `2 cells`, `4 cells` per tile, amplitudes 1, 1/2, 1/4, mapped
-/// to 0..1 as `0.5 + PERLIN_CONTRAST * sum`, clamped. Perlin noise has a standard deviation of
-/// only about 0.2, so the contrast spreads the fBm over the whole range, where coverage can carve it.
+/// to 0..1 by the soft saturation `0.5 + 0.5 tanh(2 PERLIN_CONTRAST sum)` (slope PERLIN_CONTRAST
+/// at 0). Perlin noise has a standard deviation of only about 0.2, so the contrast spreads the fBm
+/// over the whole range, where coverage can carve it. A hard clamp would leave plateaus at exactly
+/// 1, which `remap(shape, 1 - c, 1, 0, 1)` fills completely at any coverage c above 0: hard-edged
+/// boxes of full density where the weather map fades out.
 pub fn perlin_fbm01(uvw: Vec3, cells: i32, seed: u32) -> f32 {
     let sum = perlin(uvw * cells as f32, cells, seed)
         + 0.5 * perlin(uvw * (2 * cells) as f32, 2 * cells, seed ^ 0x51)
         + 0.25 * perlin(uvw * (4 * cells) as f32, 4 * cells, seed ^ 0xa3);
-    (0.5 + PERLIN_CONTRAST * sum).clamp(0.0, 1.0)
+    0.5 + 0.5 * (2.0 * PERLIN_CONTRAST * sum).tanh()
 }
 
-/// Gain from the Perlin fBm sum to its 0..1 encoding (chosen so that about 5 % of values clamp).
+/// Gain from the Perlin fBm sum to its 0..1 encoding at the middle of the range.
 pub const PERLIN_CONTRAST: f32 = 1.2;
 
 /// Gain from the curl potential's central differences to the encoded velocity.
@@ -300,6 +303,27 @@ mod tests {
         let std = (sum_sq / n as f32 - mean * mean).sqrt();
         assert!(mean.abs() < 0.03, "mean {mean}");
         assert!((0.1..0.5).contains(&std), "std {std}");
+    }
+
+    /// Plateaus at exactly 1 in the Perlin-Worley channel become boxes of full density wherever
+    /// the coverage is above 0 (see [`perlin_fbm01`]): the channel must almost never saturate,
+    /// while still spanning most of its range.
+    #[test]
+    fn perlin_worley_spans_the_range_without_saturating() {
+        let n = 20_000;
+        let (mut saturated, mut hi) = (0, 0_u8);
+        for i in 0..n {
+            let texel = IVec3::new(
+                (pcg_hash(i) % 128) as i32,
+                (pcg_hash(i + 50_000) % 128) as i32,
+                (pcg_hash(i + 90_000) % 128) as i32,
+            );
+            let perlin_worley = NoiseKind::Base.texel(3, texel)[0];
+            saturated += u32::from(perlin_worley == 255);
+            hi = hi.max(perlin_worley);
+        }
+        assert!(saturated * 1000 < n, "{saturated} of {n} texels at 1");
+        assert!(hi > 240, "the channel only reaches {hi}");
     }
 
     #[test]

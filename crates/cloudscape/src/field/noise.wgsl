@@ -85,7 +85,7 @@ fn noise_perlin_fbm01(uvw: vec3<f32>, cells: i32, seed: u32) -> f32 {
     let sum = noise_perlin(uvw * f32(cells), cells, seed)
         + 0.5 * noise_perlin(uvw * f32(2 * cells), 2 * cells, seed ^ 0x51u)
         + 0.25 * noise_perlin(uvw * f32(4 * cells), 4 * cells, seed ^ 0xa3u);
-    return clamp(0.5 + 1.2 * sum, 0.0, 1.0); // PERLIN_CONTRAST
+    return 0.5 + 0.5 * tanh(2.4 * sum); // 2 PERLIN_CONTRAST
 }
 
 fn noise_remap(value: f32, lo0: f32, hi0: f32, lo1: f32, hi1: f32) -> f32 {
