@@ -2,13 +2,14 @@
 
 mod ffmpeg;
 
-use crate::common::{GpuArgs, SceneArgs, Stages, progress_bar};
+use crate::common::{GpuArgs, SceneArgs, Stages, parse_divisor, progress_bar, temporal_reuse};
 use anyhow::{Context, Result, anyhow};
 use clap::{Args, ValueEnum};
 use cloudscape::animation::{GifPreview, scene_at, time_range_s};
-use cloudscape::gpu::GpuContext;
+use cloudscape::frame::Frame;
+use cloudscape::gpu::{GpuContext, PassTimer};
 use cloudscape::image::LdrImage;
-use cloudscape::renderer::{Rendered, SceneRenderer};
+use cloudscape::renderer::{PASSES, Rendered, Reuse, SceneRenderer};
 use cloudscape::scene::{CloudLayer, Scene, SceneDocument};
 use ffmpeg::Mp4Writer;
 use glam::UVec2;
@@ -37,6 +38,10 @@ pub struct AnimateArgs {
     /// Largest width of preview.gif in pixels (frames are scaled down to it, never up).
     #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..))]
     preview_width: u32,
+    /// Reuse earlier frames: march one ray per N x N pixels per frame (1, 2 or 4) and reproject
+    /// the history for the rest, as a real-time host would (fast; the first frames are coarse).
+    #[arg(long, value_name = "N", value_parser = parse_divisor)]
+    temporal: Option<u32>,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -176,27 +181,33 @@ impl Previews {
     }
 }
 
-/// A renderer for stills of one scene, rebuilt only when a still's layers (whose coverage the
-/// animation may change) differ from those its cloud field was built from.
-struct StillRenderer<'a> {
+/// A renderer for the frames of one scene, rebuilt only when a still's layers (whose coverage the
+/// animation may change) differ from those its cloud field was built from. A rebuild restarts the
+/// temporal history.
+struct FrameRenderer<'a> {
     ctx: &'a GpuContext,
     doc: &'a SceneDocument,
     /// The renderer and the layers its cloud field was built from.
     renderer: Option<(SceneRenderer, Vec<CloudLayer>)>,
+    /// Temporal reuse and the timer its frames need; None renders every frame as a still.
+    temporal: Option<(Reuse, PassTimer)>,
     rebuilds: u32,
 }
 
-impl<'a> StillRenderer<'a> {
-    fn new(ctx: &'a GpuContext, doc: &'a SceneDocument) -> StillRenderer<'a> {
-        StillRenderer {
+impl<'a> FrameRenderer<'a> {
+    fn new(ctx: &'a GpuContext, doc: &'a SceneDocument, temporal: Option<u32>) -> Self {
+        FrameRenderer {
             ctx,
             doc,
             renderer: None,
+            temporal: temporal
+                .map(|d| (temporal_reuse(d), PassTimer::new(ctx, PASSES.len() as u32))),
             rebuilds: 0,
         }
     }
 
-    fn render(&mut self, still: &Scene, progress: impl FnMut(f32)) -> Result<Rendered> {
+    /// Renders `still` as frame `index` of the sequence.
+    fn render(&mut self, still: &Scene, index: u32, progress: impl FnMut(f32)) -> Result<Rendered> {
         let stale = self
             .renderer
             .as_ref()
@@ -208,13 +219,22 @@ impl<'a> StillRenderer<'a> {
             self.renderer = Some((renderer, still.layers.clone()));
         }
         let (renderer, _) = self.renderer.as_mut().expect("built above");
-        Ok(renderer.render(self.ctx, still, progress))
+        let Some((reuse, timer)) = self.temporal.as_mut() else {
+            return Ok(renderer.render(self.ctx, still, progress));
+        };
+        let size = UVec2::new(still.render.width, still.render.height);
+        let frame = Frame {
+            frame_index: index,
+            ..Frame::from_scene(still, size)
+        };
+        renderer.render_frame(self.ctx, still, &frame, *reuse, timer);
+        Ok(renderer.images(self.ctx))
     }
 }
 
 /// Renders every frame of `sequence`, writing it to `dir` and adding it to `previews`.
 fn render_frames(
-    stills: &mut StillRenderer,
+    frames: &mut FrameRenderer,
     sequence: &Sequence,
     dir: &Path,
     previews: &mut Previews,
@@ -223,9 +243,10 @@ fn render_frames(
     let total = sequence.frames as f32;
     for index in 0..sequence.frames {
         bar.set_message(format!("frame {}/{}", index + 1, sequence.frames));
-        let still = scene_at(&stills.doc.scene, sequence.time_s(index));
+        let still = scene_at(&frames.doc.scene, sequence.time_s(index));
         let at = |f: f32| ((index as f32 + f) / total * 1000.0) as u64;
-        let images = stills.render(&still, |f| bar.set_position(at(f)))?;
+        let images = frames.render(&still, index, |f| bar.set_position(at(f)))?;
+        bar.set_position(at(1.0));
         sequence
             .format
             .write(&images, &dir.join(sequence.file_name(index)))?;
@@ -245,19 +266,22 @@ pub fn run(args: AnimateArgs) -> Result<()> {
     let ctx = stages.run("opening GPU", || args.gpu.open(&doc))?;
     let render = &doc.scene.render;
     let size = UVec2::new(render.width, render.height);
+    let reuse = args.temporal.map_or(String::new(), |d| {
+        format!(", temporal reuse (one ray per {d}x{d} pixels per frame)")
+    });
     eprintln!(
-        "rendering {} frames of {}x{} at {} fps from {} s, {:?} quality",
+        "rendering {} frames of {}x{} at {} fps from {} s, {:?} quality{reuse}",
         sequence.frames, size.x, size.y, sequence.fps, sequence.start_s, render.quality
     );
     let mut previews = Previews::start(&args.out, size, &args)?;
-    let mut stills = StillRenderer::new(&ctx, &doc);
+    let mut frames = FrameRenderer::new(&ctx, &doc, args.temporal);
     stages.run("rendering frames", || {
-        render_frames(&mut stills, &sequence, &args.out, &mut previews)
+        render_frames(&mut frames, &sequence, &args.out, &mut previews)
     })?;
-    if stills.rebuilds > 0 {
+    if frames.rebuilds > 0 {
         eprintln!(
             "coverage changed: the cloud field was rebuilt for {} of {} frames",
-            stills.rebuilds, sequence.frames
+            frames.rebuilds, sequence.frames
         );
     }
     let written = stages.run("finishing previews", || previews.finish(&args.out))?;

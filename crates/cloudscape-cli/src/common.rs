@@ -3,6 +3,8 @@
 use anyhow::{Context, Result, anyhow};
 use clap::Args;
 use cloudscape::gpu::{Backend, GpuContext, GpuOptions};
+use cloudscape::raymarch::temporal::TemporalSettings;
+use cloudscape::renderer::Reuse;
 use cloudscape::scene::SceneDocument;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -120,4 +122,23 @@ pub fn progress_bar(message: &'static str) -> ProgressBar {
     bar.set_style(style);
     bar.set_message(message);
     bar
+}
+
+/// `--temporal N`: a march-grid divisor, 1, 2 or 4.
+pub fn parse_divisor(text: &str) -> Result<u32, String> {
+    match text.parse::<u32>() {
+        Ok(n @ (1 | 2 | 4)) => Ok(n),
+        _ => Err(format!(
+            "{text} is not a march-grid divisor; allowed 1, 2 or 4"
+        )),
+    }
+}
+
+/// Temporal reuse marching one ray per `divisor` x `divisor` pixels per frame, otherwise the
+/// default settings.
+pub fn temporal_reuse(divisor: u32) -> Reuse {
+    Reuse::Temporal(TemporalSettings {
+        divisor,
+        ..TemporalSettings::default()
+    })
 }

@@ -6,23 +6,17 @@
 
 use cloudscape::field::VoxelGrid;
 use cloudscape::gpu::GpuContext;
-use cloudscape::image::{LdrImage, flip};
+use cloudscape::image::LdrImage;
 use cloudscape::renderer::SceneRenderer;
 use cloudscape::scene::SceneDocument;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
+use support::{check, manifest_dir};
+
+mod support;
 
 /// Size of every golden render: small, because CI renders them on a 2-core software GPU.
 const SIZE: [u32; 2] = [256, 144];
-/// Bounds on the FLIP error against the golden: mean and 99th percentile. Measured: GL llvmpipe
-/// against the Vulkan lavapipe goldens scores 0.002-0.022 (the grainiest view); small real changes
-/// score more (sun 3 degrees lower 0.053, detail erosion 0.35 -> 0.30 0.036, ambient x0.85 0.088).
-const MAX_MEAN: f32 = 0.03;
-const MAX_P99: f32 = 0.25;
-
-fn manifest_dir() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
 
 /// Renders `toml` (with `overrides`) at [`SIZE`], files resolving against `base_dir`.
 fn render(toml: &str, base_dir: &Path, overrides: &[&str]) -> LdrImage {
@@ -34,38 +28,6 @@ fn render(toml: &str, base_dir: &Path, overrides: &[&str]) -> LdrImage {
     let ctx = GpuContext::for_tests();
     let mut renderer = SceneRenderer::new(&ctx, &doc.scene, base_dir).expect("field builds");
     renderer.render(&ctx, &doc.scene, |_| {}).ldr
-}
-
-/// Compares `actual` with the golden `name`, or rewrites the golden when asked to.
-fn check(name: &str, actual: &LdrImage) {
-    let golden_path = manifest_dir()
-        .join("tests/golden")
-        .join(format!("{name}.png"));
-    if std::env::var_os("CLOUDSCAPE_UPDATE_GOLDENS").is_some() {
-        actual.write_png(&golden_path).expect("write golden");
-        return;
-    }
-    let golden = LdrImage::read_png(&golden_path).unwrap_or_else(|e| {
-        panic!("{e}: run with CLOUDSCAPE_UPDATE_GOLDENS=1 to create the golden")
-    });
-    let (stats, difference) = flip(&golden, actual).expect("same size");
-    eprintln!("{name}: FLIP mean {:.4}, p99 {:.4}", stats.mean, stats.p99);
-    if stats.mean > MAX_MEAN || stats.p99 > MAX_P99 {
-        let dir = manifest_dir().join("../../target/golden-failures");
-        std::fs::create_dir_all(&dir).expect("failure directory");
-        actual
-            .write_png(&dir.join(format!("{name}-actual.png")))
-            .expect("write actual");
-        difference
-            .write_png(&dir.join(format!("{name}-difference.png")))
-            .expect("write difference");
-        panic!(
-            "{name}: FLIP mean {:.4} (max {MAX_MEAN}), p99 {:.4} (max {MAX_P99}); see {}",
-            stats.mean,
-            stats.p99,
-            dir.display()
-        );
-    }
 }
 
 #[test]

@@ -107,3 +107,34 @@ fn the_frame_rate_must_be_positive() {
     assert!(!run.success);
     assert!(messages.contains("allowed > 0"), "{messages}");
 }
+
+#[test]
+fn animate_temporal_renders_the_frames_with_temporal_reuse() {
+    let scratch = Scratch::new("temporal");
+    let scene = flythrough();
+    let run = |out: &str, extra: &[&str]| {
+        let mut args = vec![scene.as_str(), "--frames", "2", "--fps", "24", "--out", out];
+        args.extend(TINY);
+        args.extend(extra);
+        let run = animate(scratch.path(), &args);
+        assert!(run.success, "{}", run.stderr);
+        run.stderr
+    };
+    let messages = run("temporal", &["--temporal", "4"]);
+    assert!(messages.contains("temporal reuse"), "{messages}");
+    run("stills", &[]);
+    let read = |dir: &str, i: u32| {
+        LdrImage::read_png(&scratch.join(&format!("{dir}/frame_{i:04}.png"))).expect("a frame")
+    };
+    for i in 0..2 {
+        assert_eq!(
+            (read("temporal", i).width, read("temporal", i).height),
+            (64, 36)
+        );
+        assert_ne!(
+            read("temporal", i),
+            read("stills", i),
+            "frame {i} was not marched coarsely"
+        );
+    }
+}

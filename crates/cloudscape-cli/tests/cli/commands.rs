@@ -170,3 +170,66 @@ fn bench_json_reports_each_pass_and_the_frame_wall_time() {
     assert!(wall_ms > 0.0, "{report}");
     assert!(scratch.file_names().is_empty(), "bench wrote a file");
 }
+
+/// `scenes/flythrough.toml` of the repository, as an absolute path.
+fn flythrough_scene() -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/flythrough.toml");
+    path.display().to_string()
+}
+
+#[test]
+fn bench_flythrough_compares_both_marches_with_converged_frames() {
+    let scratch = Scratch::new("bench-flythrough");
+    let scene = flythrough_scene();
+    let mut args = vec![
+        "bench",
+        "--flythrough",
+        &scene,
+        "--frames",
+        "3",
+        "--warmup",
+        "0",
+    ];
+    args.extend(["--reference-spp", "2", "--reference-step-factor", "2"]);
+    args.extend(["--out", "frames", "--json"]);
+    args.extend(TINY);
+    let run = cloudscape(scratch.path(), &args, true);
+    assert!(run.success, "{}", run.stderr);
+    let report: serde_json::Value = serde_json::from_str(&run.stdout).expect("JSON on stdout");
+    let frames = report["per_frame"].as_array().expect("per-frame records");
+    assert_eq!(frames.len(), 3);
+    assert_eq!(report["time_range_s"], serde_json::json!([0.0, 10.0]));
+    for march in ["full", "temporal"] {
+        let flip = frames[1][march]["flip_mean"].as_f64().expect("a FLIP mean");
+        assert!(flip > 0.0 && flip < 0.5, "{march}: {flip}");
+        assert!(
+            frames[0][march]["flicker"].is_null(),
+            "no flicker on the first frame"
+        );
+        assert!(frames[1][march]["flicker"].as_f64().is_some(), "{report}");
+    }
+    // The fly-through ends 1.5 km above the layer's top: skipping is measured there.
+    let skipping = &report["empty_space_skipping"];
+    let samples = |key: &str| skipping[key].as_f64().expect("samples per pixel");
+    assert!(samples("samples_on") < samples("samples_off"), "{skipping}");
+    assert_eq!(report["targets"].as_array().map(Vec::len), Some(4));
+    let shown = LdrImage::read_png(&scratch.join("frames/frame_0002.png")).expect("a frame strip");
+    assert_eq!((shown.width, shown.height), (3 * 64, 36));
+}
+
+#[test]
+fn bench_flythrough_without_a_scene_looks_for_the_flythrough_scene() {
+    let args = ["bench", "--flythrough"];
+    assert_args_rejected(
+        "bench-flythrough-default",
+        &args,
+        true,
+        &["scenes/flythrough.toml"],
+    );
+}
+
+#[test]
+fn flythrough_options_need_flythrough() {
+    let args = ["bench", "--reference-spp", "4"];
+    assert_args_rejected("bench-reference-spp", &args, false, &["--flythrough"]);
+}

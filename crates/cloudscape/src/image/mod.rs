@@ -152,6 +152,20 @@ impl HdrImage {
     }
 }
 
+impl LdrImage {
+    /// Rec. 709 luma of every pixel: the luminance weights applied to the sRGB-encoded values
+    /// (ITU-R BT.709), in [0, 1]; alpha is ignored. What a viewer sees change between frames.
+    pub fn luma(&self) -> Vec<f32> {
+        self.pixels
+            .iter()
+            .map(|p| {
+                let weighted: f64 = (0..3).map(|c| LUMINANCE_WEIGHTS[c] * f64::from(p[c])).sum();
+                (weighted / 255.0) as f32
+            })
+            .collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -171,6 +185,19 @@ mod tests {
         hdr.pixels = vec![[1.0, 1.0, 1.0, 1.0], [0.0, 1.0, 0.0, 1.0]];
         assert!((hdr.mean_luminance() - (1.0 + 0.7152) / 2.0).abs() < 1e-12);
         assert_eq!(HdrImage::new(0, 0).mean_luminance(), 0.0);
+    }
+
+    #[test]
+    fn luma_weights_the_encoded_channels() {
+        let image = LdrImage {
+            width: 3,
+            height: 1,
+            pixels: vec![[255, 255, 255, 0], [0, 255, 0, 255], [0, 0, 0, 255]],
+        };
+        let luma = image.luma();
+        assert!((luma[0] - 1.0).abs() < 1e-6, "{luma:?}");
+        assert!((luma[1] - 0.7152).abs() < 1e-6, "{luma:?}");
+        assert_eq!(luma[2], 0.0);
     }
 
     #[test]

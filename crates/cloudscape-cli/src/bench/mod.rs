@@ -1,11 +1,14 @@
-//! `cloudscape bench`: GPU time per pass from timestamp queries, and wall time per frame.
+//! `cloudscape bench`: GPU time per pass from timestamp queries, and wall time per frame; with
+//! `--flythrough`, the temporal march against the full march and a converged reference over an
+//! animated sequence ([`flythrough`]).
 
-use crate::common::{GpuArgs, SceneArgs};
+mod flythrough;
+
+use crate::common::{GpuArgs, SceneArgs, parse_divisor, temporal_reuse};
 use anyhow::{Result, anyhow};
 use clap::Args;
 use cloudscape::frame::Frame;
-use cloudscape::gpu::PassTimer;
-use cloudscape::raymarch::temporal::TemporalSettings;
+use cloudscape::gpu::{GpuContext, PassTimer};
 use cloudscape::renderer::{PASSES, Reuse, SceneRenderer};
 use glam::UVec2;
 use serde::Serialize;
@@ -15,30 +18,24 @@ use serde::Serialize;
 pub struct BenchArgs {
     #[command(flatten)]
     scene: SceneArgs,
-    /// Frames to time (after warm-up frames).
-    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..))]
-    frames: u32,
+    /// Frames to time (after warm-up frames) [default: 30; with --flythrough 120, spread over the
+    /// whole animation].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    frames: Option<u32>,
     /// Untimed frames first (pipeline compilation, caches).
     #[arg(long, default_value_t = 3)]
     warmup: u32,
     /// Print the result as JSON on stdout.
     #[arg(long)]
     json: bool,
-    /// March one ray per N x N pixels per frame (1, 2 or 4) and reuse history between frames.
+    /// March one ray per N x N pixels per frame (1, 2 or 4) and reuse history between frames
+    /// [default: none; with --flythrough 4].
     #[arg(long, value_name = "N", value_parser = parse_divisor)]
     temporal: Option<u32>,
     #[command(flatten)]
+    flythrough: flythrough::FlythroughArgs,
+    #[command(flatten)]
     gpu: GpuArgs,
-}
-
-/// A march-grid divisor: 1, 2 or 4.
-fn parse_divisor(text: &str) -> Result<u32, String> {
-    match text.parse::<u32>() {
-        Ok(n @ (1 | 2 | 4)) => Ok(n),
-        _ => Err(format!(
-            "{text} is not a march-grid divisor; allowed 1, 2 or 4"
-        )),
-    }
 }
 
 /// Summary of one timed quantity over the frames, milliseconds.
@@ -78,8 +75,18 @@ struct Report {
     density_samples_per_pixel: f64,
 }
 
-/// Renders the scene's frame repeatedly, with the jitter advancing, and reports timings.
+/// Runs the fly-through measurement with `--flythrough`, the repeated-frame timing otherwise.
 pub fn run(args: BenchArgs) -> Result<()> {
+    if args.flythrough.flythrough {
+        flythrough::run(args)
+    } else {
+        run_repeated(args)
+    }
+}
+
+/// Renders the scene's frame repeatedly, with the jitter advancing, and reports timings.
+fn run_repeated(args: BenchArgs) -> Result<()> {
+    let frames = args.frames.unwrap_or(30);
     let doc = args.scene.load(&[])?;
     let scene = &doc.scene;
     let ctx = args.gpu.open(&doc)?;
@@ -87,16 +94,10 @@ pub fn run(args: BenchArgs) -> Result<()> {
         .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
     let mut frame = Frame::from_scene(scene, UVec2::new(scene.render.width, scene.render.height));
     let mut timer = PassTimer::new(&ctx, PASSES.len() as u32);
-    let reuse = match args.temporal {
-        Some(divisor) => Reuse::Temporal(TemporalSettings {
-            divisor,
-            ..TemporalSettings::default()
-        }),
-        None => Reuse::None,
-    };
+    let reuse = args.temporal.map_or(Reuse::None, temporal_reuse);
     let mut pass_ms: Vec<Vec<f64>> = vec![Vec::new(); PASSES.len()];
     let mut wall_ms = Vec::new();
-    for i in 0..args.warmup + args.frames {
+    for i in 0..args.warmup + frames {
         frame.frame_index = i;
         let wall = renderer.render_frame(&ctx, scene, &frame, reuse, &mut timer);
         if i < args.warmup {
@@ -113,9 +114,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
         adapter: ctx.summary(),
         width: frame.size.x,
         height: frame.size.y,
-        frames: args.frames,
+        frames,
         timestamps: ctx.has_timestamps(),
-        software: ctx.adapter_info().device_type == wgpu::DeviceType::Cpu,
+        software: is_software(&ctx),
         passes: PASSES
             .iter()
             .zip(pass_ms)
@@ -126,6 +127,11 @@ pub fn run(args: BenchArgs) -> Result<()> {
         density_samples_per_pixel: renderer.march_stats(&ctx).density_samples_per_pixel,
     };
     print_report(&report, args.json)
+}
+
+/// Whether the adapter is a CPU (software) one, whose timestamp queries do not time shaders.
+fn is_software(ctx: &GpuContext) -> bool {
+    ctx.adapter_info().device_type == wgpu::DeviceType::Cpu
 }
 
 fn print_report(report: &Report, json: bool) -> Result<()> {
