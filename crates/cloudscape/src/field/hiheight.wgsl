@@ -41,18 +41,15 @@ fn hiheight_descent_t(o: vec3<f32>, d: vec3<f32>, t: f32, top_m: f32) -> f32 {
     return max(below.x, t);
 }
 
-// (empty_until, check_again_at): the layers hold no cloud on [t, empty_until); when that is t
-// itself, the next query is worth making only from check_again_at on (the ray is in a level-0 cell
-// that may hold cloud until then).
-fn field_empty_until(o: vec3<f32>, d: vec3<f32>, t: f32, t_end: f32) -> vec2<f32> {
+// The layers hold no cloud on [t, field_empty_until(o, d, t, t_end)): climbs the pyramid while
+// the ray's cells are empty and steps down where they may hold cloud, until a level-0 cell may.
+fn field_empty_until(o: vec3<f32>, d: vec3<f32>, t: f32, t_end: f32) -> f32 {
     let levels = field.counts.z;
     var level = min(4u, levels - 1u);
     var t_cur = t;
-    var result = vec2<f32>(t, t);
     for (var iteration = 0u; iteration < 32u; iteration++) {
         if t_cur >= t_end {
-            result = vec2<f32>(t_end, t_end);
-            break;
+            return t_end;
         }
         // Look the cell up just past t_cur, so that a t_cur on a cell boundary finds the cell the
         // ray is entering; t_cur itself stays exact, so no sample beyond a boundary is skipped.
@@ -69,17 +66,14 @@ fn field_empty_until(o: vec3<f32>, d: vec3<f32>, t: f32, t_end: f32) -> vec2<f32
                 exit = min(exit, hiheight_descent_t(o, d, t_cur, cell.top_m));
             }
         }
-        result = vec2<f32>(t_cur, t_cur);
         if empty {
             t_cur = max(exit, t_cur + 1.0e-3 + 1.0e-6 * t_cur);
             level = min(level + 1u, levels - 1u);
-            result = vec2<f32>(t_cur, t_cur);
         } else if level == 0u {
-            result = vec2<f32>(t_cur, max(exit, t_cur));
             break;
         } else {
             level -= 1u;
         }
     }
-    return result;
+    return t_cur;
 }

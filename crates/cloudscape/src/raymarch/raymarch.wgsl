@@ -156,10 +156,29 @@ fn march_step_count(length_m: f32) -> u32 {
     return u32(f32(march.counts.x) * scale);
 }
 
+// Where the leading stretch of [t0, t1] that the hi-height pyramid proves empty ends (t0 when
+// skipping is off). The pyramid does not describe voxel grids, so the stretch ends at the first.
+// One query per ray, before the march: queries between samples would make the lanes of a SIMD
+// group wait on each other's traversals, and cost more than the empty samples they save.
+fn march_empty_until(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, volume: vec2<f32>) -> f32 {
+    if march.flags.x != 1u || field.counts.z == 0u {
+        return t0;
+    }
+    return min(field_empty_until(o, d, t0, t1), max(volume.x, t0));
+}
+
+// The stratum the march starts from: one before the stratum holding `empty_until` (rounding may
+// misplace it by one), whose samples before `empty_until` the march skips one by one.
+fn march_first_stratum(t0: f32, t1: f32, n: u32, empty_until: f32) -> u32 {
+    let u = sqrt(clamp((empty_until - t0) / (t1 - t0), 0.0, 1.0)); // inverse of march_stratum_t
+    return u32(max(f32(n) * u - 1.0, 0.0));
+}
+
 // Integrates [t0, t1] in `march_step_count` strata, one sample per stratum at fraction `jitter` of it,
 // with Hillaire 2016's energy-conserving step: S_int = (S - S exp(-sigma_t dt)) / sigma_t;
 // L += T S_int; T *= exp(-sigma_t dt).
-// `volume` is the stretch inside voxel-grid boxes, which the hi-height pyramid does not describe.
+// Samples in the leading empty stretch (march_empty_until) are skipped: they would read zero.
+// `volume` is the stretch inside voxel-grid boxes.
 fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volume: vec2<f32>) -> MarchResult {
     let n = march_step_count(t1 - t0);
     let cos_theta = dot(d, frame.sun_direction.xyz);
@@ -168,22 +187,17 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
     var transmittance = 1.0;
     var depth_weighted = 0.0;
     var samples = 0u;
-    var skip = vec2<f32>(t0, t0); // (empty until, query again at) from field_empty_until
-    let skipping = march.flags.x == 1u && field.counts.z > 0u;
-    var t_start = t0;
-    for (var i = 0u; i < n; i++) {
+    let empty_until = march_empty_until(o, d, t0, t1, volume);
+    let first = march_first_stratum(t0, t1, n, empty_until);
+    var t_start = march_stratum_t(t0, t1, f32(first) / f32(n));
+    for (var i = first; i < n; i++) {
         let t_end = march_stratum_t(t0, t1, f32(i + 1u) / f32(n));
         let dt = t_end - t_start;
-                let t = t_start + jitter * dt;
+        let t = t_start + jitter * dt;
         let p = o + d * t;
         t_start = t_end;
-        if skipping && (t < volume.x || t > volume.y) {
-            if t >= skip.y {
-                skip = field_empty_until(o, d, t, t1);
-            }
-            if t < skip.x {
-                continue;
-            }
+        if t < empty_until {
+            continue;
         }
         samples += 1u;
         let sigma_t = field_extinction(p);

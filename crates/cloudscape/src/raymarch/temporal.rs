@@ -93,6 +93,7 @@ fn bayer_rank(p: UVec2, size: u32) -> u32 {
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct TemporalUniform {
     prev_clip_from_world: Mat4,
+    prev_camera_m: Vec4,
     wind_shift_m: Vec4,
     blend: Vec4,
     grid: UVec4,
@@ -106,12 +107,14 @@ struct PreviousFrame {
     time_s: f32,
 }
 
-/// A march grid's targets and the two full-resolution history buffers.
+/// A march grid's targets and the two full-resolution history buffers, with the cloud distance
+/// each history pixel shows.
 struct Buffers {
     size: UVec2,
     clouds: wgpu::TextureView,
     cloud_depth: wgpu::TextureView,
     history: [wgpu::TextureView; 2],
+    history_depth: [wgpu::TextureView; 2],
 }
 
 /// The temporal ray march: a [`RaymarchRenderer`] on a coarse grid plus the resolve pass.
@@ -147,6 +150,8 @@ impl TemporalMarch {
             sampler_type,
             unfilterable,
             storage_texture_2d(CLOUD_FORMAT),
+            unfilterable,
+            storage_texture_2d(CLOUD_DEPTH_FORMAT),
         ];
         let layout = bind_group_layout(&ctx.device, "temporal resolve", &types);
         let pipeline = compute_pipeline(
@@ -216,6 +221,9 @@ impl TemporalMarch {
         let previous = if cut { None } else { self.previous };
         let uniform = TemporalUniform {
             prev_clip_from_world: previous.map_or(clip_from_world, |p| p.clip_from_world),
+            prev_camera_m: previous
+                .map_or(frame.camera_position_m, |p| p.camera_m)
+                .extend(0.0),
             wind_shift_m: (wind_m_per_s * previous.map_or(0.0, |p| frame.time_s - p.time_s))
                 .extend(0.0)
                 .extend(0.0),
@@ -265,6 +273,8 @@ impl TemporalMarch {
                 wgpu::BindingResource::Sampler(&self.sampler),
                 wgpu::BindingResource::TextureView(host_depth),
                 wgpu::BindingResource::TextureView(&buffers.history[write]),
+                wgpu::BindingResource::TextureView(&buffers.history_depth[read]),
+                wgpu::BindingResource::TextureView(&buffers.history_depth[write]),
             ],
         );
         dispatch_2d(
@@ -305,6 +315,10 @@ impl TemporalMarch {
             history: [
                 texture("cloud history a", size, CLOUD_FORMAT),
                 texture("cloud history b", size, CLOUD_FORMAT),
+            ],
+            history_depth: [
+                texture("cloud history depth a", size, CLOUD_DEPTH_FORMAT),
+                texture("cloud history depth b", size, CLOUD_DEPTH_FORMAT),
             ],
         });
         self.previous = None;

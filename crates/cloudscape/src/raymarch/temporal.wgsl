@@ -4,6 +4,7 @@
 
 struct Temporal {
     prev_clip_from_world: mat4x4<f32>,
+    prev_camera_m: vec4<f32>, // the previous frame's camera position (xyz)
     wind_shift_m: vec4<f32>, // how far the wind moved the clouds since the previous frame: x, z (m)
     blend: vec4<f32>,        // weight of a pixel's own fresh sample, clip gamma (sigmas)
     grid: vec4<u32>,         // divisor, sub-pixel x, y updated this frame, 1 if the history is valid
@@ -17,6 +18,14 @@ struct Temporal {
 @group(0) @binding(5) var history_linear: sampler;
 @group(0) @binding(6) var temporal_host_depth: texture_2d<f32>;
 @group(0) @binding(7) var history_out: texture_storage_2d<rgba16float, write>;
+// Distance from its frame's camera to the cloud each history pixel shows (0: none).
+@group(0) @binding(8) var history_depth_in: texture_2d<f32>;
+@group(0) @binding(9) var history_depth_out: texture_storage_2d<r32float, write>;
+
+// The history is trusted where the cloud it shows lies within this fraction of the distance at which
+// the current estimate puts it; otherwise it shows something else (a disocclusion, the inside of a
+// cloud the camera has left) and is dropped.
+const TEMPORAL_DEPTH_TOLERANCE: f32 = 0.25;
 
 // Moves q toward the centre of the box [lo, hi] until it lies inside (Pedersen 2016, "Temporal
 // Reprojection Anti-Aliasing in INSIDE", clipping rather than clamping).
@@ -27,6 +36,46 @@ fn temporal_clip(q: vec4<f32>, lo: vec4<f32>, hi: vec4<f32>) -> vec4<f32> {
     let a = abs(v / extent);
     let m = max(max(a.x, a.y), max(a.z, a.w));
     return select(q, centre + v / m, m > 1.0);
+}
+
+// The history at uv through a Catmull-Rom bicubic filter, nine bilinear taps (Jimenez 2016,
+// "Filmic SMAA", SIGGRAPH course; weights of Catmull & Rom 1974). A moving camera resamples the
+// history every frame: bilinear resampling blurs it a little more each time, the bicubic does not.
+fn temporal_history_bicubic(uv: vec2<f32>) -> vec4<f32> {
+    let size = vec2<f32>(textureDimensions(history_in));
+    let pos = uv * size - 0.5;
+    let p1 = floor(pos) + 0.5;
+    let f = pos - floor(pos);
+    let w0 = f * (-0.5 + f * (1.0 - 0.5 * f));
+    let w1 = 1.0 + f * f * (-2.5 + 1.5 * f);
+    let w2 = f * (0.5 + f * (2.0 - 1.5 * f));
+    let w3 = f * f * (-0.5 + 0.5 * f);
+    let w12 = w1 + w2;
+    let t0 = (p1 - 1.0) / size;
+    let t3 = (p1 + 2.0) / size;
+    let t12 = (p1 + w2 / w12) / size;
+    var sum = vec4<f32>(0.0);
+    for (var j = 0; j < 3; j++) {
+        let y = select(select(t3.y, t12.y, j == 1), t0.y, j == 0);
+        let wy = select(select(w3.y, w12.y, j == 1), w0.y, j == 0);
+        sum += textureSampleLevel(history_in, history_linear, vec2<f32>(t0.x, y), 0.0) * (w0.x * wy);
+        sum += textureSampleLevel(history_in, history_linear, vec2<f32>(t12.x, y), 0.0) * (w12.x * wy);
+        sum += textureSampleLevel(history_in, history_linear, vec2<f32>(t3.x, y), 0.0) * (w3.x * wy);
+    }
+    return max(sum, vec4<f32>(0.0));
+}
+
+// Whether the history at uv shows the cloud this pixel sees at `world` (`distance_m` from the
+// camera; the far distance where there is none): the previous camera saw it at the distance the
+// history recorded, within TEMPORAL_DEPTH_TOLERANCE.
+fn temporal_same_cloud(uv: vec2<f32>, world: vec3<f32>, distance_m: f32) -> bool {
+    let size = vec2<f32>(textureDimensions(history_depth_in));
+    let texel = clamp(vec2<i32>(uv * size), vec2<i32>(0), vec2<i32>(size) - 1);
+    let recorded = textureLoad(history_depth_in, texel, 0).x;
+    let far = frame.camera_position.w;
+    let expected_m = select(far, distance(world, temporal.prev_camera_m.xyz), distance_m < far);
+    let recorded_m = select(far, recorded, recorded > 0.0);
+    return abs(recorded_m - expected_m) <= TEMPORAL_DEPTH_TOLERANCE * max(recorded_m, expected_m);
 }
 
 fn temporal_grid_texel(texel: vec2<i32>) -> vec2<i32> {
@@ -71,8 +120,9 @@ fn resolve_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     let fresh = all(id.xy % divisor == temporal.grid.yz);
     if fresh {
         current = textureLoad(current_clouds, own, 0);
+        cloud_m = textureLoad(current_depth, own, 0).x;
     }
-    // Neighbourhood statistics of the current grid: mean +- gamma sigma (the seed's ClipAABB).
+    // Neighbourhood statistics of the current grid: the spread sigma of the seed's ClipAABB.
     var m1 = vec4<f32>(0.0);
     var m2 = vec4<f32>(0.0);
     for (var y = -1; y <= 1; y++) {
@@ -84,6 +134,9 @@ fn resolve_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let mean = m1 / 9.0;
     let sigma = sqrt(abs(m2 / 9.0 - mean * mean));
+    // The box is centred on this pixel's own estimate, which varies smoothly from pixel to pixel,
+    // rather than on the block's mean, which would print the march grid's blocks into the history.
+    let centre = current;
     // Reproject: where the cloud this pixel sees was in the previous frame, at its estimated
     // depth (the far distance where there is none), moved back against the wind.
     let d = frame_ray_direction(frame, pixel);
@@ -94,12 +147,13 @@ fn resolve_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     let uv = vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
     let on_screen = clip.w > 0.0 && all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0));
     var result = current;
-    if temporal.grid.w == 1u && on_screen {
+    if temporal.grid.w == 1u && on_screen && temporal_same_cloud(uv, world, distance_m) {
         let gamma = temporal.blend.y;
-        let history = temporal_clip(textureSampleLevel(history_in, history_linear, uv, 0.0), mean - gamma * sigma, mean + gamma * sigma);
+        let history = temporal_clip(temporal_history_bicubic(uv), centre - gamma * sigma, centre + gamma * sigma);
         // lerp(history, current, w): w is the pixel's own-sample weight when it has one; otherwise
         // the reprojected history stands (Horizon Zero Dawn's scheme for pixels not marched).
         result = select(history, mix(history, current, temporal.blend.x), fresh);
     }
     textureStore(history_out, vec2<i32>(id.xy), result);
+    textureStore(history_depth_out, vec2<i32>(id.xy), vec4<f32>(cloud_m, 0.0, 0.0, 0.0));
 }
