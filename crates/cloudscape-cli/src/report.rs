@@ -14,7 +14,7 @@ use cloudscape::field::noise::perlin;
 use cloudscape::gpu::GpuContext;
 use cloudscape::image::{HdrImage, write_image};
 use cloudscape::renderer::SceneRenderer;
-use cloudscape::scene::SceneDocument;
+use cloudscape::scene::{Scene, SceneDocument};
 use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer, ProgressiveRender};
 use glam::{UVec2, Vec3};
 use std::fmt::Write as _;
@@ -274,10 +274,11 @@ fn cached_reference(doc: &SceneDocument, args: &ReportArgs) -> Result<Reference>
     Ok(reference)
 }
 
-/// A name for the references of this scene and these settings.
+/// A name for the references of this scene and these settings: what the path tracer sees, so
+/// that tuning the ray marcher's lighting and steps, or their defaults, keeps the cached references.
 fn cache_key(doc: &SceneDocument, args: &ReportArgs) -> Result<String> {
     let mut hasher = std::collections::hash_map::DefaultHasher::new();
-    toml::to_string(&doc.scene)?.hash(&mut hasher);
+    path_traced_part(&doc.scene)?.to_string().hash(&mut hasher);
     for path in doc.scene.volumes.iter().map(|v| doc.resolve_path(&v.path)) {
         std::fs::read(&path)
             .with_context(|| path.display().to_string())?
@@ -285,6 +286,24 @@ fn cache_key(doc: &SceneDocument, args: &ReportArgs) -> Result<String> {
     }
     (args.spp, args.seed, env!("CARGO_PKG_VERSION")).hash(&mut hasher);
     Ok(format!("{:016x}", hasher.finish()))
+}
+
+/// Keys of the `[lighting]` and `[render]` tables that the path tracer reads; the others only
+/// steer the real-time techniques.
+const PATH_TRACED_KEYS: [(&str, &[&str]); 2] = [
+    ("lighting", &["albedo"]),
+    ("render", &["width", "height", "time_s"]),
+];
+
+/// `scene` as a TOML table without the settings only the real-time techniques read.
+fn path_traced_part(scene: &Scene) -> Result<toml::Table> {
+    let mut table = toml::Table::try_from(scene)?;
+    for (section, kept) in PATH_TRACED_KEYS {
+        if let Some(toml::Value::Table(t)) = table.get_mut(section) {
+            t.retain(|key, _| kept.contains(&key));
+        }
+    }
+    Ok(table)
 }
 
 /// The pixel-wise mean of two images of one size.
@@ -409,4 +428,28 @@ fn markdown(rows: &[Row], args: &ReportArgs, adapter: &str) -> String {
         );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cloudscape::scene::Quality;
+
+    #[test]
+    fn cached_references_ignore_what_only_the_ray_marcher_reads() {
+        let scene = Scene::default();
+        let key = |s: &Scene| path_traced_part(s).expect("a scene serialises");
+        let mut tuned = scene.clone();
+        tuned.lighting.octaves += 1;
+        tuned.lighting.ambient_scale *= 0.5;
+        tuned.render.quality = Quality::Ultra;
+        tuned.render.exposure_ev = 2.0;
+        assert_eq!(key(&scene), key(&tuned));
+        let mut absorbing = scene.clone();
+        absorbing.lighting.albedo = 0.9;
+        assert_ne!(key(&scene), key(&absorbing));
+        let mut wider = scene.clone();
+        wider.render.width += 1;
+        assert_ne!(key(&scene), key(&wider));
+    }
 }
