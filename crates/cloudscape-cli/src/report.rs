@@ -37,11 +37,12 @@ pub struct ReportArgs {
     /// Image height in pixels.
     #[arg(long, default_value_t = 90)]
     height: u32,
-    /// Path-traced samples per pixel (half with each of two seeds, for the noise floor).
-    #[arg(long, default_value_t = 48, value_parser = clap::value_parser!(u32).range(2..))]
+    /// Path-traced samples per pixel (half with each of two seeds, for the noise floor). 256 take
+    /// about 15 minutes for the cumulonimbus on 2 cores, a few minutes for the others.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(2..))]
     spp: u32,
     /// Most seconds of path tracing per scene; the image so far is used after it.
-    #[arg(long, default_value_t = 150.0)]
+    #[arg(long, default_value_t = 1800.0)]
     time_budget: f64,
     /// Seed of the path tracer (the noise-floor half uses the next one).
     #[arg(long, default_value_t = 1)]
