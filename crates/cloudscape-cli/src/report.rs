@@ -9,12 +9,13 @@ use crate::compare::Comparison;
 use crate::reference::deadline_after;
 use anyhow::{Context, Result, anyhow};
 use clap::Args;
-use cloudscape::field::VoxelGrid;
 use cloudscape::field::noise::perlin;
+use cloudscape::field::{CloudField, VoxelGrid};
 use cloudscape::gpu::GpuContext;
 use cloudscape::image::{HdrImage, write_image};
+use cloudscape::raymarch::temporal::halton;
 use cloudscape::renderer::SceneRenderer;
-use cloudscape::scene::SceneDocument;
+use cloudscape::scene::{Scene, SceneDocument};
 use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer, ProgressiveRender};
 use glam::{UVec2, Vec3};
 use std::fmt::Write as _;
@@ -37,11 +38,12 @@ pub struct ReportArgs {
     /// Image height in pixels.
     #[arg(long, default_value_t = 90)]
     height: u32,
-    /// Path-traced samples per pixel (half with each of two seeds, for the noise floor).
-    #[arg(long, default_value_t = 48, value_parser = clap::value_parser!(u32).range(2..))]
+    /// Path-traced samples per pixel (half with each of two seeds, for the noise floor). 256 take
+    /// about 15 minutes for the cumulonimbus on 2 cores, a few minutes for the others.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(2..))]
     spp: u32,
     /// Most seconds of path tracing per scene; the image so far is used after it.
-    #[arg(long, default_value_t = 150.0)]
+    #[arg(long, default_value_t = 1800.0)]
     time_budget: f64,
     /// Seed of the path tracer (the noise-floor half uses the next one).
     #[arg(long, default_value_t = 1)]
@@ -274,17 +276,60 @@ fn cached_reference(doc: &SceneDocument, args: &ReportArgs) -> Result<Reference>
     Ok(reference)
 }
 
-/// A name for the references of this scene and these settings.
+/// A name for the references of this scene and these settings: what the path tracer sees, so
+/// that tuning the ray marcher's lighting and steps, or their defaults, keeps the cached references.
 fn cache_key(doc: &SceneDocument, args: &ReportArgs) -> Result<String> {
     let mut hasher = std::collections::hash_map::DefaultHasher::new();
-    toml::to_string(&doc.scene)?.hash(&mut hasher);
+    path_traced_part(&doc.scene)?.to_string().hash(&mut hasher);
     for path in doc.scene.volumes.iter().map(|v| doc.resolve_path(&v.path)) {
         std::fs::read(&path)
             .with_context(|| path.display().to_string())?
             .hash(&mut hasher);
     }
+    hash_field(doc, &mut hasher)?;
     (args.spp, args.seed, env!("CARGO_PKG_VERSION")).hash(&mut hasher);
     Ok(format!("{:016x}", hasher.finish()))
+}
+
+/// Hashes the scene's cloud field itself, its extinction at a fixed scatter of points through the
+/// layers and the voxel boxes, so that a change to the field's code (noise, profiles, coverage)
+/// retraces the references as a change to the scene does.
+fn hash_field(doc: &SceneDocument, hasher: &mut impl Hasher) -> Result<()> {
+    let field = CloudField::new(&doc.scene, &doc.resolve_path(""))
+        .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
+    let (bottom_m, top_m) = field.altitude_range_m().unwrap_or((0.0, 0.0));
+    let layer_box = (
+        Vec3::new(-20_000.0, bottom_m, -20_000.0),
+        Vec3::new(40_000.0, top_m - bottom_m, 40_000.0),
+    );
+    let boxes = field.volumes.iter().map(|v| (v.min_m, v.size_m));
+    for (min_m, size_m) in std::iter::once(layer_box).chain(boxes) {
+        for i in 0..512_u32 {
+            let unit = Vec3::new(halton(i + 1, 2), halton(i + 1, 3), halton(i + 1, 5));
+            let p = min_m + unit * size_m;
+            let extinction = field.extinction_per_m(p, doc.scene.render.time_s);
+            extinction.to_bits().hash(hasher);
+        }
+    }
+    Ok(())
+}
+
+/// Keys of the `[lighting]` and `[render]` tables that the path tracer reads; the others only
+/// steer the real-time techniques.
+const PATH_TRACED_KEYS: [(&str, &[&str]); 2] = [
+    ("lighting", &["albedo"]),
+    ("render", &["width", "height", "time_s"]),
+];
+
+/// `scene` as a TOML table without the settings only the real-time techniques read.
+fn path_traced_part(scene: &Scene) -> Result<toml::Table> {
+    let mut table = toml::Table::try_from(scene)?;
+    for (section, kept) in PATH_TRACED_KEYS {
+        if let Some(toml::Value::Table(t)) = table.get_mut(section) {
+            t.retain(|key, _| kept.contains(&key));
+        }
+    }
+    Ok(table)
 }
 
 /// The pixel-wise mean of two images of one size.
@@ -409,4 +454,28 @@ fn markdown(rows: &[Row], args: &ReportArgs, adapter: &str) -> String {
         );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cloudscape::scene::Quality;
+
+    #[test]
+    fn cached_references_ignore_what_only_the_ray_marcher_reads() {
+        let scene = Scene::default();
+        let key = |s: &Scene| path_traced_part(s).expect("a scene serialises");
+        let mut tuned = scene.clone();
+        tuned.lighting.octaves += 1;
+        tuned.lighting.ambient_scale *= 0.5;
+        tuned.render.quality = Quality::Ultra;
+        tuned.render.exposure_ev = 2.0;
+        assert_eq!(key(&scene), key(&tuned));
+        let mut absorbing = scene.clone();
+        absorbing.lighting.albedo = 0.9;
+        assert_ne!(key(&scene), key(&absorbing));
+        let mut wider = scene.clone();
+        wider.render.width += 1;
+        assert_ne!(key(&scene), key(&wider));
+    }
 }

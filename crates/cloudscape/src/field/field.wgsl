@@ -202,3 +202,60 @@ fn field_extinction(p: vec3<f32>) -> f32 {
 fn field_extinction_coarse(p: vec3<f32>) -> f32 {
     return field_extinction_detail(p, false);
 }
+
+// The first stretch of the ray, within [0, t_max], inside the layers' altitude band.
+fn field_layer_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
+    if field.counts.x == 0u {
+        return vec2<f32>(1.0, -1.0);
+    }
+    let outer = field_below(o, d, field.planet.w);
+    let inner = field_below(o, d, field.planet.z);
+    var t0 = max(outer.x, 0.0);
+    var t1 = min(outer.y, t_max);
+    if inner.x < inner.y {
+        if inner.x <= t0 && inner.y > t0 {
+            t0 = inner.y; // starts below the layer: enter where the ray rises out of the inner ball
+        } else if inner.x > t0 {
+            t1 = min(t1, inner.x); // from above or inside: stop where the ray sinks below the layer
+        }
+    }
+    return vec2<f32>(t0, t1);
+}
+
+// The hull of the ray's stretches inside the voxel-grid boxes.
+fn field_volume_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
+    var hull = vec2<f32>(FIELD_NO_HIT, -FIELD_NO_HIT);
+    for (var i = 0u; i < field.counts.y; i++) {
+        let v = field.volumes[i];
+        let inv = 1.0 / d;
+        let a = (v.min_m.xyz - o) * inv;
+        let b = (v.min_m.xyz + v.size_m.xyz - o) * inv;
+        let t0 = max(max(max(min(a.x, b.x), min(a.y, b.y)), min(a.z, b.z)), 0.0);
+        let t1 = min(min(min(max(a.x, b.x), max(a.y, b.y)), max(a.z, b.z)), t_max);
+        if t0 < t1 {
+            hull = vec2<f32>(min(hull.x, t0), max(hull.y, t1));
+        }
+    }
+    return hull;
+}
+
+// Optical depth of the coarse (uneroded) field along p + t dir over t in [span.x, span.x + span.y],
+// from n segments whose lengths grow by the factor span.z from one to the next (2: Schneider 2015's
+// doubling light samples, fine near p; 1: uniform), each sampled at a jittered point; the segments'
+// offsets are decorrelated from `jitter` and from each other by the golden ratio.
+fn field_optical_depth_coarse(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: u32, jitter: f32) -> f32 {
+    var total = f32(n);
+    if span.z != 1.0 {
+        total = (pow(span.z, f32(n)) - 1.0) / (span.z - 1.0);
+    }
+    var width = span.y / total;
+    var start = span.x;
+    var tau = 0.0;
+    for (var k = 0u; k < n; k++) {
+        let offset = fract(jitter + f32(k + 1u) * 0.618034);
+        tau += field_extinction_coarse(p + dir * (start + width * offset)) * width;
+        start += width;
+        width *= span.z;
+    }
+    return tau;
+}

@@ -11,6 +11,7 @@ struct Frame {
     sky_mean_up: vec4<f32>,     // rgb mean radiance over the upper hemisphere
     ground_albedo: vec4<f32>,   // rgb albedo, 1 if there is a ground
     ground_radiance: vec4<f32>, // rgb radiance leaving the unshadowed ground
+    cloud_optics: vec4<f32>,    // mean cosine g of the cloud droplets' phase function, 0, 0, 0
 }
 
 // Unit direction of the ray through pixel coordinates `pixel` (y down), as Frame::camera_ray.
@@ -43,4 +44,12 @@ fn frame_haze(frame: Frame, radiance: vec3<f32>, coverage: f32, distance_m: f32)
 // step banding into grain without the visible pattern of structured dithers at low sample counts.
 fn frame_pixel_jitter(pixel: vec2<u32>, index: u32) -> f32 {
     return noise_hash_to_unit(noise_pcg_hash(pixel.x ^ noise_pcg_hash(pixel.y ^ noise_pcg_hash(index))));
+}
+
+// Eddington (two-stream) diffuse transmittance of a conservatively scattering slab of optical depth
+// tau: 1 / (1 + 3/4 (1 - g) tau) (e.g. Bohren 1987, "Multiple scattering of light and some of its
+// observable consequences", Am. J. Phys. 55): diffuse light is dimmed by the transport optical
+// depth (1 - g) tau, and only algebraically, not exponentially.
+fn frame_diffuse_transmittance(frame: Frame, tau: f32) -> f32 {
+    return 1.0 / (1.0 + 0.75 * (1.0 - frame.cloud_optics.x) * tau);
 }

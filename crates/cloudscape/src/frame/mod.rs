@@ -1,6 +1,7 @@
 //! One frame's view and light: the camera, the sun, the sky and the ground, derived from a scene or
 //! given by a host renderer, and the `Frame` uniform that every pass reads (`frame.wgsl`).
 
+use crate::optics::PhaseLobes;
 use crate::scene::{Scene, SkyModel};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, UVec2, Vec3, Vec4};
@@ -93,6 +94,9 @@ pub struct Frame {
     pub sky: SkyRadiance,
     /// Lambertian ground albedo; None without a ground.
     pub ground_albedo: Option<Vec3>,
+    /// Mean cosine `g` of the cloud droplets' phase function: how far diffuse light gets through
+    /// clouds (their transport optical depth is `(1 - g) tau`).
+    pub cloud_mean_cosine: f32,
     /// Scene time, seconds.
     pub time_s: f32,
     /// Frame counter that decorrelates the sampling jitter of successive frames.
@@ -134,6 +138,7 @@ impl Frame {
                 .ground
                 .enabled
                 .then(|| Vec3::from_array(scene.ground.albedo)),
+            cloud_mean_cosine: PhaseLobes::from_scene(&scene.phase).mean_cosine(),
             time_s: scene.render.time_s,
             frame_index: 0,
         }
@@ -182,6 +187,7 @@ impl Frame {
             sky_mean_up: self.sky.mean_radiance_up().extend(0.0),
             ground_albedo: ground,
             ground_radiance: self.ground_radiance().extend(0.0),
+            cloud_optics: Vec4::new(self.cloud_mean_cosine, 0.0, 0.0, 0.0),
         }
     }
 }
@@ -200,6 +206,7 @@ pub struct FrameUniform {
     sky_mean_up: Vec4,
     ground_albedo: Vec4,
     ground_radiance: Vec4,
+    cloud_optics: Vec4,
 }
 
 #[cfg(test)]

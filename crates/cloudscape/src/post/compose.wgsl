@@ -1,5 +1,6 @@
 // Puts the clouds over the background this crate draws when there is no host scene: the sky, the
-// sun's disc and the ground. final = background * transmittance + cloud radiance.
+// sun's disc and the ground in the clouds' shadows. final = background * transmittance + cloud
+// radiance.
 
 @group(1) @binding(0) var<uniform> frame: Frame;
 @group(1) @binding(1) var compose_clouds: texture_2d<f32>;
@@ -14,6 +15,42 @@ fn compose_sun_disc(d: vec3<f32>) -> vec3<f32> {
     return frame.sun_irradiance.xyz / (3.14159265 * r * r);
 }
 
+// Samples of the coarse optical depth from the ground through the layers, and again through the
+// voxel-grid boxes: uniform segments (unlike the march's doubling ones, which are fine near a point
+// inside the cloud), so the clouds far along the ray are sampled as finely as near ones.
+const COMPOSE_SHADOW_STEPS: u32 = 24u;
+
+// Coarse optical depth of the clouds from ground point g toward dir (upward).
+fn compose_optical_depth(g: vec3<f32>, dir: vec3<f32>, jitter: f32) -> f32 {
+    var tau = 0.0;
+    for (var i = 0u; i < 2u; i++) {
+        var span = field_layer_interval(g, dir, FIELD_NO_HIT);
+        if i == 1u {
+            span = field_volume_interval(g, dir, FIELD_NO_HIT);
+        }
+        if span.x < span.y {
+            tau += field_optical_depth_coarse(g, dir, vec3<f32>(span.x, span.y - span.x, 1.0), COMPOSE_SHADOW_STEPS, jitter);
+        }
+    }
+    return tau;
+}
+
+// Radiance leaving the Lambertian ground at g: the sun's and the sky's share of ground_radiance,
+// each dimmed by the clouds' diffuse transmittance between the ground and the light (the sun's
+// along its slant path: the direct beam and the light the clouds scatter forward, most of it
+// within a few degrees of the sun), as the path tracer's ground sees them through the same field.
+fn compose_ground(g: vec3<f32>, jitter: f32) -> vec3<f32> {
+    let sun = frame.sun_direction.xyz;
+    let sun_part = frame.ground_albedo.xyz / 3.14159265 * frame.sun_irradiance.xyz * max(sun.y, 0.0);
+    let sky_part = frame.ground_radiance.xyz - sun_part;
+    var sun_t = 0.0;
+    if sun.y > 0.0 {
+        sun_t = frame_diffuse_transmittance(frame, compose_optical_depth(g, sun, jitter));
+    }
+    let sky_t = frame_diffuse_transmittance(frame, compose_optical_depth(g, field_up(g), jitter));
+    return sun_part * sun_t + sky_part * sky_t;
+}
+
 @compute @workgroup_size(8, 8)
 fn compose_background(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= u32(frame.viewport.x) || id.y >= u32(frame.viewport.y) {
@@ -25,7 +62,8 @@ fn compose_background(@builtin(global_invocation_id) id: vec3<u32>) {
     var background = frame_sky_radiance(frame, d) + compose_sun_disc(d);
     let ground_m = field_ground_distance(o, d, frame.ground_albedo.w > 0.5);
     if ground_m < frame.camera_position.w {
-        background = frame_haze(frame, frame.ground_radiance.xyz, 1.0, ground_m);
+        let jitter = frame_pixel_jitter(id.xy, u32(frame.viewport.w));
+        background = frame_haze(frame, compose_ground(o + d * ground_m, jitter), 1.0, ground_m);
     }
     let clouds = textureLoad(compose_clouds, vec2<i32>(id.xy), 0);
     textureStore(compose_out, vec2<i32>(id.xy), vec4<f32>(background * clouds.a + clouds.rgb, 1.0));

@@ -31,7 +31,7 @@ pub fn display_source() -> String {
     [tonemap::TONEMAP_WGSL, DISPLAY_WGSL].concat()
 }
 
-/// Composes the cloud target over the sky, the sun's disc and the ground.
+/// Composes the cloud target over the sky, the sun's disc and the ground in the clouds' shadows.
 pub struct Background {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,

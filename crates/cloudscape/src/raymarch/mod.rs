@@ -240,12 +240,7 @@ impl RaymarchRenderer {
             ),
             octaves: Vec4::new(a, b, c, settings.albedo),
             phase: Vec4::from_array(settings.phase.to_gpu()),
-            ambient: Vec4::new(
-                settings.ambient_scale,
-                settings.phase.mean_cosine(),
-                0.0,
-                0.0,
-            ),
+            ambient: Vec4::new(settings.ambient_scale, 0.0, 0.0, 0.0),
             tile: UVec4::ZERO,
             flags: UVec4::new(settings.empty_space_skipping as u32, 0, 0, 0),
             grid: UVec4::new(

@@ -5,7 +5,7 @@ struct March {
     counts: vec4<u32>,  // primary steps, light steps, samples per pixel, octaves
     octaves: vec4<f32>, // attenuation a, contribution b, eccentricity c, single-scattering albedo
     phase: vec4<f32>,   // phase lobes (optics::PhaseLobes::to_gpu)
-    ambient: vec4<f32>, // ambient scale, phase mean cosine g
+    ambient: vec4<f32>, // ambient scale, 0, 0, 0
     tile: vec4<u32>,    // origin x, y of the pixel tile this dispatch covers, its width
     flags: vec4<u32>,   // 1 to skip empty space with the hi-height pyramid
     grid: vec4<u32>,    // divisor of the march grid, sub-pixel x, y updated this frame, 1 if temporal
@@ -36,71 +36,17 @@ const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
 // is complete, and longer single-sample segments only add noise.
 const MARCH_SUN_PATH_MAX_M: f32 = 4000.0;
 
-// The first stretch of the ray, within [0, t_max], inside the layers' altitude band.
-fn march_layer_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
-    if field.counts.x == 0u {
-        return vec2<f32>(1.0, -1.0);
-    }
-    let outer = field_below(o, d, field.planet.w);
-    let inner = field_below(o, d, field.planet.z);
-    var t0 = max(outer.x, 0.0);
-    var t1 = min(outer.y, t_max);
-    if inner.x < inner.y {
-        if inner.x <= t0 && inner.y > t0 {
-            t0 = inner.y; // starts below the layer: enter where the ray rises out of the inner ball
-        } else if inner.x > t0 {
-            t1 = min(t1, inner.x); // from above or inside: stop where the ray sinks below the layer
-        }
-    }
-    return vec2<f32>(t0, t1);
-}
-
-// The hull of the ray's stretches inside the voxel-grid boxes.
-fn march_volume_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
-    var hull = vec2<f32>(FIELD_NO_HIT, -FIELD_NO_HIT);
-    for (var i = 0u; i < field.counts.y; i++) {
-        let v = field.volumes[i];
-        let inv = 1.0 / d;
-        let a = (v.min_m.xyz - o) * inv;
-        let b = (v.min_m.xyz + v.size_m.xyz - o) * inv;
-        let t0 = max(max(max(min(a.x, b.x), min(a.y, b.y)), min(a.z, b.z)), 0.0);
-        let t1 = min(min(min(max(a.x, b.x), max(a.y, b.y)), max(a.z, b.z)), t_max);
-        if t0 < t1 {
-            hull = vec2<f32>(min(hull.x, t0), max(hull.y, t1));
-        }
-    }
-    return hull;
-}
-
 // Optical depth toward the sun from p, through the coarse (uneroded) density as Schneider 2015's
-// cheap light samples: `light_steps` segments whose lengths double, covering the way
-// to the top of the layers (at most MARCH_SUN_PATH_MAX_M), each sampled at a jittered point (VolumeCloud samples the
-// sun path at 0.5, 1.5, 3, 6, 12 units with weights 1, 1, 2, 4, 8; peers.md).
+// cheap light samples: `light_steps` segments whose lengths double, covering the way to the top of
+// the layers (at most MARCH_SUN_PATH_MAX_M) (VolumeCloud samples the sun path at 0.5, 1.5, 3, 6, 12
+// units with weights 1, 1, 2, 4, 8; peers.md).
 fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
     let sun = frame.sun_direction.xyz;
     var length_m = MARCH_SUN_PATH_MAX_M;
     if field.counts.x > 0u {
         length_m = clamp(field_below(p, sun, field.planet.w).y, 50.0, MARCH_SUN_PATH_MAX_M);
     }
-    let n = march.counts.y;
-    let unit = length_m / f32((1u << n) - 1u);
-    var tau = 0.0;
-    var start = 0.0;
-    for (var k = 0u; k < n; k++) {
-        let width = unit * f32(1u << k);
-        let offset = fract(jitter + f32(k + 1u) * 0.618034); // decorrelated from the view jitter
-        tau += field_extinction_coarse(p + sun * (start + width * offset)) * width;
-        start += width;
-    }
-    return tau;
-}
-
-// Eddington (two-stream) diffuse transmittance of a conservatively scattering slab of optical depth
-// tau and asymmetry g: 1 / (1 + 3/4 (1 - g) tau) (e.g. Bohren 1987, "Multiple scattering of light
-// and some of its observable consequences", Am. J. Phys. 55): diffuse light is dimmed by the
-// transport optical depth and only algebraically, not exponentially.
-fn march_diffuse_transmittance(tau: f32) -> f32 {
-    return 1.0 / (1.0 + 0.75 * (1.0 - march.ambient.y) * tau);
+    return field_optical_depth_coarse(p, sun, vec3<f32>(0.0, length_m, 2.0), march.counts.y, jitter);
 }
 
 // Light scattered from the sky above and the ground below, per unit sigma_s: each hemisphere
@@ -122,7 +68,7 @@ fn march_ambient(p: vec3<f32>, h: f32) -> vec3<f32> {
         ground = frame.sky_horizon.xyz;
     }
     let sky = frame.sky_mean_up.xyz;
-    return march.ambient.x * 0.5 * (sky * march_diffuse_transmittance(tau_up) + ground * march_diffuse_transmittance(tau_down));
+    return march.ambient.x * 0.5 * (sky * frame_diffuse_transmittance(frame, tau_up) + ground * frame_diffuse_transmittance(frame, tau_down));
 }
 
 // Sun light scattered toward the eye per unit sigma_s, with multiple-scattering octaves
@@ -285,8 +231,8 @@ fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     if spp > 1u {
         sample_index = march_sums[slot].samples;
     }
-    let layer = march_layer_interval(o, d, t_max);
-    let volume = march_volume_interval(o, d, t_max);
+    let layer = field_layer_interval(o, d, t_max);
+    let volume = field_volume_interval(o, d, t_max);
     let t0 = min(select(FIELD_NO_HIT, layer.x, layer.x < layer.y), volume.x);
     let t1 = max(select(-FIELD_NO_HIT, layer.y, layer.x < layer.y), volume.y);
     var result = vec4<f32>(0.0, 0.0, 0.0, 1.0);
