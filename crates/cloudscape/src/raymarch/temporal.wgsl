@@ -103,18 +103,23 @@ fn resolve_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     var current = vec4<f32>(0.0);
     var cloud_m = 0.0;
     var weight = 0.0;
+    var cloud_weight = 0.0;
     for (var k = 0; k < 4; k++) {
         let offset = vec2<i32>(k & 1, k >> 1u);
         let texel = temporal_grid_texel(vec2<i32>(base) + offset);
         let w2 = select(1.0 - f, f, vec2<bool>(offset == vec2<i32>(1)));
         let depth_m = textureLoad(current_depth, texel, 0).x;
         let w = w2.x * w2.y * select(1.0, 0.0, depth_m > host_m) + 1.0e-6;
-        current += textureLoad(current_clouds, texel, 0) * w;
-        cloud_m += depth_m * w;
+        let sample = textureLoad(current_clouds, texel, 0);
+        current += sample * w;
         weight += w;
+        // The cloud's distance averages over the samples that see cloud, by how much they see:
+        // a clear sample (distance 0) would pull an edge's distance halfway to the camera.
+        cloud_m += depth_m * w * (1.0 - sample.a);
+        cloud_weight += w * (1.0 - sample.a);
     }
     current /= weight;
-    cloud_m /= weight;
+    cloud_m = select(0.0, cloud_m / cloud_weight, cloud_weight > 1.0e-6);
     // The pixel this frame's ray went through has a sample of its own.
     let own = vec2<i32>(id.xy / divisor);
     let fresh = all(id.xy % divisor == temporal.grid.yz);
@@ -151,8 +156,8 @@ fn resolve_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
         let gamma = temporal.blend.y;
         let history = temporal_clip(temporal_history_bicubic(uv), centre - gamma * sigma, centre + gamma * sigma);
         // lerp(history, current, w): w is the pixel's own-sample weight when it has one; otherwise
-        // the reprojected history stands (Horizon Zero Dawn's scheme for pixels not marched).
-        result = select(history, mix(history, current, temporal.blend.x), fresh);
+        // the seed's 0.05 toward the upsampled estimate, which bleeds out what clipping let through.
+        result = mix(history, current, select(0.05, temporal.blend.x, fresh));
     }
     textureStore(history_out, vec2<i32>(id.xy), result);
     textureStore(history_depth_out, vec2<i32>(id.xy), vec4<f32>(cloud_m, 0.0, 0.0, 0.0));
