@@ -5,6 +5,7 @@ use super::hiheight::HiHeight;
 use super::{CloudField, MAX_LAYERS, MAX_VOLUMES, NoiseKind};
 use crate::gpu::pipeline::{
     UNIFORM, bind_group, bind_group_layout, compute_pipeline, float_texture, storage_binding,
+    storage_buffer,
 };
 use crate::gpu::{GpuContext, readback};
 use bytemuck::{Pod, Zeroable};
@@ -259,12 +260,7 @@ impl FieldGpu {
             contents: bytemuck::cast_slice(&points4),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let output = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("probe extinction"),
-            size: (points.len().max(1) * 4) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
+        let output = storage_buffer(ctx, "probe extinction", (points.len().max(1) * 4) as u64);
         let layout = bind_group_layout(
             device,
             "probe",
@@ -420,12 +416,11 @@ fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture
         contents: bytemuck::bytes_of(&params),
         usage: wgpu::BufferUsages::UNIFORM,
     });
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("noise texels"),
-        size: (row_pitch * dims.y * dims.z * 4) as u64,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
+    let buffer = storage_buffer(
+        ctx,
+        "noise texels",
+        (row_pitch * dims.y * dims.z * 4) as u64,
+    );
     let layout = bind_group_layout(
         device,
         "noise generator",

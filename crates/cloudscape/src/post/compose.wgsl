@@ -20,19 +20,20 @@ fn compose_sun_disc(d: vec3<f32>) -> vec3<f32> {
 // inside the cloud), so the clouds far along the ray are sampled as finely as near ones.
 const COMPOSE_SHADOW_STEPS: u32 = 24u;
 
-// Coarse optical depth of the clouds from ground point g toward dir (upward).
-fn compose_optical_depth(g: vec3<f32>, dir: vec3<f32>, jitter: f32) -> f32 {
-    var tau = 0.0;
-    for (var i = 0u; i < 2u; i++) {
-        var span = field_layer_interval(g, dir, FIELD_NO_HIT);
-        if i == 1u {
-            span = field_volume_interval(g, dir, FIELD_NO_HIT);
-        }
-        if span.x < span.y {
-            tau += field_optical_depth_coarse(g, dir, vec3<f32>(span.x, span.y - span.x, 1.0), COMPOSE_SHADOW_STEPS, jitter);
-        }
+// Coarse optical depth from ground point g toward dir over the ray stretch [span.x, span.y].
+fn compose_span_optical_depth(g: vec3<f32>, dir: vec3<f32>, span: vec2<f32>, jitter: f32) -> f32 {
+    if span.x >= span.y {
+        return 0.0;
     }
-    return tau;
+    return field_optical_depth_coarse(g, dir, vec3<f32>(span.x, span.y - span.x, 1.0), COMPOSE_SHADOW_STEPS, jitter);
+}
+
+// Coarse optical depth of the clouds from ground point g toward dir (upward): the layers, then the
+// voxel-grid boxes.
+fn compose_optical_depth(g: vec3<f32>, dir: vec3<f32>, jitter: f32) -> f32 {
+    let layers = field_layer_interval(g, dir, FIELD_NO_HIT);
+    let volumes = field_volume_interval(g, dir, FIELD_NO_HIT);
+    return compose_span_optical_depth(g, dir, layers, jitter) + compose_span_optical_depth(g, dir, volumes, jitter);
 }
 
 // Radiance leaving the Lambertian ground at g: the sun's and the sky's share of ground_radiance,
