@@ -3,9 +3,9 @@
 use anyhow::{Context, Result, anyhow};
 use clap::Args;
 use cloudscape::gpu::{Backend, GpuContext, GpuOptions};
-use cloudscape::raymarch::temporal::TemporalSettings;
 use cloudscape::renderer::Reuse;
 use cloudscape::scene::SceneDocument;
+use cloudscape::temporal::TemporalSettings;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};

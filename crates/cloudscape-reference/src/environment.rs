@@ -1,42 +1,19 @@
 //! The light and the surfaces around the clouds: the sun disc, the sky, the ground and the haze,
-//! exactly as the frame of the GPU techniques defines them (`cloudscape::frame::Frame`).
+//! exactly as the GPU techniques see them (`cloudscape::environment` and `cloudscape::frame`).
 
 use crate::geometry::{ground_distance, up};
 use crate::sampling::{
     UNIFORM_HEMISPHERE_PDF, UNIFORM_SPHERE_PDF, uniform_hemisphere, uniform_sphere,
 };
+use cloudscape::environment::SkyRadiance;
+pub use cloudscape::environment::SunDisc;
 use cloudscape::field::PlanetGeometry;
-use cloudscape::frame::{Frame, SkyRadiance};
+use cloudscape::frame::Frame;
 use glam::{Vec2, Vec3};
-use std::f32::consts::TAU;
 
 /// How far above the ground a path leaving it starts, metres: a few `f32` steps at 200 km from the
 /// origin, far below any cloud detail.
 const GROUND_OFFSET_M: f32 = 0.05;
-
-/// The sun, a uniform disc.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SunDisc {
-    /// Unit vector toward the centre of the disc.
-    pub direction: Vec3,
-    /// Irradiance on a surface facing the sun (the disc's radiance integrated over it).
-    pub irradiance: Vec3,
-    /// Cosine of the angular radius.
-    pub cos_radius: f32,
-}
-
-impl SunDisc {
-    /// Radiance seen in direction `dir`: `E / Omega` inside the disc of solid angle
-    /// `Omega = 2 pi (1 - cos r)`, zero outside and for a point sun.
-    pub fn radiance(&self, dir: Vec3) -> Vec3 {
-        let solid_angle = TAU * (1.0 - self.cos_radius);
-        if solid_angle > 0.0 && dir.dot(self.direction) >= self.cos_radius {
-            self.irradiance / solid_angle
-        } else {
-            Vec3::ZERO
-        }
-    }
-}
 
 /// Sun, sky, ground and haze.
 #[derive(Clone, Debug, PartialEq)]
@@ -61,16 +38,17 @@ pub struct GroundPoint {
 }
 
 impl Environment {
-    /// The environment of a frame over `planet`.
-    pub fn from_frame(frame: &Frame, planet: PlanetGeometry) -> Environment {
-        let sun = (frame.sun_irradiance.max_element() > 0.0).then(|| SunDisc {
-            direction: frame.sun_direction,
-            irradiance: frame.sun_irradiance,
-            cos_radius: frame.sun_angular_radius_rad.cos(),
-        });
+    /// The environment the GPU techniques light with (`light`), with the ground of `frame`, over
+    /// `planet`.
+    pub fn new(
+        frame: &Frame,
+        light: &cloudscape::environment::Environment,
+        planet: PlanetGeometry,
+    ) -> Environment {
+        let sun = (light.sun.irradiance.max_element() > 0.0).then_some(light.sun);
         Environment {
             sun,
-            sky: frame.sky,
+            sky: light.sky,
             planet,
             ground_albedo: frame.ground_albedo,
         }
@@ -99,9 +77,9 @@ impl Environment {
         self.sky.radiance(dir)
     }
 
-    /// What the eye sees of radiance `radiance` from `distance_m` away through the haze: it
-    /// fades toward the horizon radiance by `exp(-haze distance)` (Koschmieder 1924), the same
-    /// blend the GPU compose and ray-march passes apply (`frame_haze` in `frame.wgsl`).
+    /// What the eye sees of radiance `radiance` from `distance_m` away through the haze: the
+    /// aerial perspective the GPU compositor applies
+    /// ([`cloudscape::environment::Environment::aerial_perspective`] at full coverage).
     pub fn through_haze(&self, radiance: Vec3, distance_m: f32) -> Vec3 {
         let clear = (-self.sky.haze_per_m * distance_m).exp();
         radiance * clear + self.sky.horizon * (1.0 - clear)

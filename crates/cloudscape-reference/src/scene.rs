@@ -35,7 +35,8 @@ impl PathTracer<CloudMedium> {
             field.bake_noise();
         }
         let frame = Frame::from_scene(scene, size);
-        let environment = Environment::from_frame(&frame, field.planet);
+        let light = cloudscape::environment::Environment::from_scene(scene);
+        let environment = Environment::new(&frame, &light, field.planet);
         let reach_m = frame.far_m.min(MAX_GRID_REACH_M);
         let medium = CloudMedium::new(field, frame.time_s, frame.camera_position_m, reach_m);
         Ok(PathTracer {

@@ -1,11 +1,13 @@
 //! The GPU field agrees with the CPU specification at sample points: layered clouds (noise
 //! generated on the GPU, weather map, type mix, wind) and voxel grids.
 
-use cloudscape::field::gpu::FieldGpu;
-use cloudscape::field::{CloudField, VoxelGrid};
+use cloudscape::field::VoxelGrid;
+use cloudscape::frame::Frame;
 use cloudscape::gpu::GpuContext;
+use cloudscape::probe::{Probe, ProbeFunction, ProbeInput};
+use cloudscape::renderer::{CloudRenderer, Reuse};
 use cloudscape::scene::{CloudTypeMix, Scene, VolumeGrid};
-use glam::Vec3;
+use glam::{UVec2, Vec3, Vec4};
 
 /// A deterministic point in the box [min, max].
 fn point(i: u32, min: Vec3, max: Vec3) -> Vec3 {
@@ -28,10 +30,23 @@ struct Agreement {
 /// Compares GPU and CPU extinction at `points`.
 fn compare(scene: &Scene, base_dir: &std::path::Path, points: &[Vec3], time_s: f32) -> Agreement {
     let ctx = GpuContext::for_tests();
-    let field = CloudField::new(scene, base_dir).expect("field");
-    let gpu = FieldGpu::new(&ctx, &field);
-    gpu.set_time(&ctx, &field, time_s);
-    let gpu_values = gpu.probe(&ctx, points);
+    let mut clouds = CloudRenderer::new(&ctx, scene, base_dir).expect("field");
+    let frame = Frame {
+        time_s,
+        ..Frame::from_scene(scene, UVec2::new(16, 16))
+    };
+    clouds.begin_frame(&ctx, scene, &frame, Reuse::None);
+    let inputs: Vec<ProbeInput> = points
+        .iter()
+        .map(|p| ProbeInput {
+            a: p.extend(1.0),
+            b: Vec4::ZERO,
+        })
+        .collect();
+    let probe = Probe::new(&ctx, &clouds.shared());
+    let gpu = probe.run(&ctx, &clouds.shared(), ProbeFunction::Extinction, &inputs);
+    let gpu_values: Vec<f32> = gpu.iter().map(|v| v.x).collect();
+    let field = clouds.field();
     let cpu: Vec<f32> = points
         .iter()
         .map(|p| field.extinction_per_m(*p, time_s))

@@ -24,7 +24,13 @@ fn render(view: &[&str], skipping: bool) -> (HdrImage, f64) {
     let ctx = GpuContext::for_tests();
     let mut renderer = SceneRenderer::new(&ctx, &doc.scene, Path::new(".")).expect("field");
     let image = renderer.render(&ctx, &doc.scene, |_| {}).hdr;
-    (image, renderer.march_stats(&ctx).density_samples_per_pixel)
+    (
+        image,
+        renderer
+            .stats(&ctx)
+            .expect("the frame was counted")
+            .density_samples_per_pixel,
+    )
 }
 
 fn largest_difference(a: &HdrImage, b: &HdrImage) -> f32 {

@@ -1,57 +1,36 @@
-//! Clouds respect the host's depth buffer: geometry in front of the layer hides them, and the
-//! march stops at the geometry's distance. Drives the pass the way a host engine does.
+//! Clouds respect the host's depth buffer in every depth convention: geometry in front of the
+//! layer hides them, and the march stops at the geometry's distance. Drives the technique the way a
+//! host engine does, through [`CloudRenderer`].
 
-use cloudscape::field::CloudField;
-use cloudscape::field::gpu::FieldGpu;
-use cloudscape::frame::Frame;
+use cloudscape::frame::{DepthConvention, Frame};
 use cloudscape::gpu::{GpuContext, read_texture_rgba16f};
-use cloudscape::raymarch::{
-    CLOUD_DEPTH_FORMAT, CLOUD_FORMAT, MarchGrid, MarchSettings, RaymarchRenderer, RaymarchTargets,
-};
+use cloudscape::renderer::{CloudRenderer, Reuse};
 use cloudscape::scene::Scene;
-use glam::{UVec2, Vec4};
+use glam::UVec2;
 
-/// The depth-buffer value (0 near, 1 far) of a point `distance_m` straight ahead.
-fn depth_at(frame: &Frame, distance_m: f32) -> f32 {
-    let clip = frame.clip_from_view * Vec4::new(0.0, 0.0, -distance_m, 1.0);
-    clip.z / clip.w
-}
-
-fn texture(
-    ctx: &GpuContext,
-    size: UVec2,
-    format: wgpu::TextureFormat,
-    usage: wgpu::TextureUsages,
-) -> wgpu::Texture {
-    cloudscape::gpu::pipeline::texture_2d(ctx, "host depth test", size, format, usage)
-}
-
-/// Marches the default scene over a depth buffer cleared to `depth`; returns (rgb radiance sum,
-/// mean transmittance).
-fn march_over_depth(depth: f32) -> (f32, f32) {
+/// Renders the default scene over a depth buffer of `convention` cleared to the depth of a wall
+/// `wall_m` away (None: no geometry); returns (rgb radiance sum, mean transmittance).
+fn clouds_over_depth(convention: DepthConvention, wall_m: Option<f32>) -> (f32, f32) {
     let ctx = GpuContext::for_tests();
     let mut scene = Scene::default();
     scene.camera.pitch_deg = 35.0;
     scene.layers[0].coverage = 0.8;
+    scene.render.quality = cloudscape::scene::Quality::Low;
     let size = UVec2::new(64, 36);
-    let frame = Frame::from_scene(&scene, size);
-    let field = CloudField::new(&scene, std::path::Path::new(".")).expect("field");
-    let field_gpu = FieldGpu::new(&ctx, &field);
-    let mut pass = RaymarchRenderer::new(&ctx, &field_gpu);
-    pass.prepare(
-        &ctx,
-        &frame,
-        &MarchSettings::from_scene(&scene),
-        &MarchGrid::FULL,
-    );
+    let frame = Frame::from_scene(&scene, size).with_depth(&scene, convention);
+    let depth = wall_m.map_or(convention.far_value(), |d| {
+        convention.depth_of_distance(&frame.clip_from_view, d)
+    });
+    let mut clouds = CloudRenderer::new(&ctx, &scene, std::path::Path::new(".")).expect("field");
+    clouds.begin_frame(&ctx, &scene, &frame, Reuse::None);
     use wgpu::TextureUsages as U;
-    let depth_texture = texture(
+    let depth_texture = cloudscape::gpu::pipeline::texture_2d(
         &ctx,
+        "host depth",
         size,
         wgpu::TextureFormat::Depth32Float,
         U::TEXTURE_BINDING | U::RENDER_ATTACHMENT,
     );
-    let clouds = texture(&ctx, size, CLOUD_FORMAT, U::STORAGE_BINDING | U::COPY_SRC);
     let depth_view = depth_texture.create_view(&Default::default());
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -67,38 +46,25 @@ fn march_over_depth(depth: f32) -> (f32, f32) {
         }),
         ..Default::default()
     });
-    let targets = RaymarchTargets {
-        depth: &depth_view,
-        clouds: &clouds.create_view(&Default::default()),
-        cloud_depth: &texture(&ctx, size, CLOUD_DEPTH_FORMAT, U::STORAGE_BINDING)
-            .create_view(&Default::default()),
-    };
-    pass.encode(
-        &ctx,
-        &mut encoder,
-        &field_gpu,
-        &targets,
-        (UVec2::ZERO, size),
-        None,
-    );
+    clouds.encode_clouds(&ctx, &mut encoder, &depth_view, None, None);
     ctx.queue.submit([encoder.finish()]);
-    let pixels = read_texture_rgba16f(&ctx, &clouds);
+    let pixels = read_texture_rgba16f(&ctx, clouds.images().clouds.radiance_texture());
     let radiance: f32 = pixels.iter().map(|p| p[0] + p[1] + p[2]).sum();
     let transmittance = pixels.iter().map(|p| p[3]).sum::<f32>() / pixels.len() as f32;
     (radiance, transmittance)
 }
 
 #[test]
-fn geometry_in_front_of_the_layer_hides_the_clouds() {
-    let scene = Scene::default();
-    let frame = Frame::from_scene(&scene, UVec2::new(64, 36));
-    // The layer starts 1500 m up; a wall 500 m away stands in front of all of it.
-    let (radiance, transmittance) = march_over_depth(depth_at(&frame, 500.0));
-    assert_eq!(radiance, 0.0);
-    assert_eq!(transmittance, 1.0);
-    let (radiance, transmittance) = march_over_depth(1.0);
-    assert!(
-        radiance > 0.0 && transmittance < 0.8,
-        "an empty depth buffer shows the clouds: T = {transmittance}"
-    );
+fn geometry_in_front_of_the_layer_hides_the_clouds_in_every_depth_convention() {
+    for convention in DepthConvention::ALL {
+        // The layer starts 1500 m up; a wall 500 m away stands in front of all of it.
+        let (radiance, transmittance) = clouds_over_depth(convention, Some(500.0));
+        assert_eq!(radiance, 0.0, "{convention:?}");
+        assert_eq!(transmittance, 1.0, "{convention:?}");
+        let (radiance, transmittance) = clouds_over_depth(convention, None);
+        assert!(
+            radiance > 0.0 && transmittance < 0.8,
+            "{convention:?}: an empty depth buffer shows the clouds: T = {transmittance}"
+        );
+    }
 }

@@ -7,9 +7,9 @@
 use cloudscape::animation::scene_at;
 use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, PassTimer};
-use cloudscape::raymarch::temporal::TemporalSettings;
 use cloudscape::renderer::{PASSES, Reuse, SceneRenderer};
 use cloudscape::scene::SceneDocument;
+use cloudscape::temporal::TemporalSettings;
 use glam::UVec2;
 use support::{check, manifest_dir};
 

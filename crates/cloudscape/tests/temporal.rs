@@ -4,9 +4,9 @@
 use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, PassTimer};
 use cloudscape::image::{LdrImage, flip};
-use cloudscape::raymarch::temporal::TemporalSettings;
 use cloudscape::renderer::{PASSES, Reuse, SceneRenderer};
 use cloudscape::scene::{Scene, SceneDocument};
+use cloudscape::temporal::TemporalSettings;
 use glam::{UVec2, Vec3};
 use std::path::Path;
 

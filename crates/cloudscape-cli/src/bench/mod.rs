@@ -124,7 +124,9 @@ fn run_repeated(args: BenchArgs) -> Result<()> {
             .map(|(n, s)| Stat::new(n, s))
             .collect(),
         frame_wall: Stat::new("frame (wall)", wall_ms),
-        density_samples_per_pixel: renderer.march_stats(&ctx).density_samples_per_pixel,
+        density_samples_per_pixel: renderer
+            .stats(&ctx)
+            .map_or(0.0, |s| s.density_samples_per_pixel),
     };
     print_report(&report, args.json)
 }

@@ -2,8 +2,9 @@
 
 pub mod adding_doubling;
 
+use cloudscape::environment::SkyRadiance;
 use cloudscape::field::PlanetGeometry;
-use cloudscape::frame::{Frame, SkyRadiance};
+use cloudscape::frame::Frame;
 use cloudscape::optics::PhaseLobes;
 use cloudscape::scene::{PlanetShape, Scene};
 use cloudscape_reference::PathTracer;

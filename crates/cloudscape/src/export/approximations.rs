@@ -8,7 +8,7 @@
 //!   lining) differs.
 //! - A gradient sky becomes a constant sky of the same irradiance on a horizontal surface.
 
-use crate::frame::SkyRadiance;
+use crate::environment::SkyRadiance;
 use crate::optics::PhaseLobes;
 use crate::scene::{PhaseFunction, Scene, SkyModel};
 

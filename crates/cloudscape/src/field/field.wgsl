@@ -1,30 +1,47 @@
+#import constants
 // The cloud field on the GPU: the twin of field/mod.rs and field/layer.rs, line for line.
 // Everything it binds lives in bind group 0; techniques put their own resources in group 1+.
 
 struct FieldLayer {
-    shape: vec4<f32>,        // bottom_m, thickness_m, coverage, extinction_per_m
-    motion: vec4<f32>,       // wind east, wind south (m/s), weather offset u, v
-    noise_offset: vec4<f32>, // noise offset xyz (m), type coordinate at channel 0
-    type_bounds: vec4<f32>,  // channel values where the next type begins
-    type_steps: vec4<f32>,   // type-coordinate change at each bound
+    bottom_m: f32,
+    thickness_m: f32,
+    coverage: f32,                // fraction of the sky covered, calibrated
+    extinction_per_m: f32,        // where the density is 1
+    wind_m_per_s: vec2<f32>,      // east, south
+    weather_offset: vec2<f32>,    // this layer's offset into the weather map (uv)
+    noise_offset_m: vec3<f32>,    // this layer's offset into the noise
+    type_first: f32,              // type coordinate where the weather type channel is 0
+    type_bounds: vec4<f32>,       // channel values where the next type begins (3 used)
+    type_steps: vec4<f32>,        // type-coordinate change at each bound (3 used)
 }
 
 struct FieldVolume {
-    min_m: vec4<f32>,        // box minimum xyz (m), extinction_per_m where the grid is 1
-    size_m: vec4<f32>,       // box size xyz (m)
-    atlas_origin: vec4<f32>, // first texel of this grid in the atlas
-    resolution: vec4<f32>,   // grid size in texels
+    min_m: vec3<f32>,             // box minimum corner
+    extinction_per_m: f32,        // where the grid value is 1
+    size_m: vec3<f32>,            // box size
+    atlas_first_slice: f32,       // first z texel of this grid in the atlas
+    resolution_texels: vec3<f32>, // grid size
+    reserved: f32,
 }
 
 struct Field {
-    planet: vec4<f32>,     // radius_m, 1 if flat, lowest layer bottom_m, highest layer top_m
-    noise: vec4<f32>,      // base period m, detail period m, detail erosion, curl displacement m
-    weather: vec4<f32>,    // weather extent x, z (m), time_s
-    counts: vec4<u32>,     // layer count, volume count, hi-height level count
-    atlas_size: vec4<f32>, // atlas texels xyz
-    layers: array<FieldLayer, 4>,
-    volumes: array<FieldVolume, 4>,
-    hiheight_levels: array<vec4<u32>, 16>, // per level: first cell, width, height
+    planet_radius_m: f32,
+    flat_planet: u32,             // 1 on a flat planet
+    layer_bottom_m: f32,          // lowest layer bottom: the layer band's floor
+    layer_top_m: f32,             // highest layer top: the layer band's ceiling
+    base_noise_period_m: f32,
+    detail_noise_period_m: f32,
+    detail_erosion: f32,
+    curl_displacement_m: f32,
+    weather_extent_m: vec2<f32>,  // world size of one weather-map tile, x and z
+    time_s: f32,                  // scene time the wind has moved the clouds to
+    layer_count: u32,
+    volume_count: u32,
+    hiheight_level_count: u32,
+    reserved: vec2<u32>,
+    layers: array<FieldLayer, MAX_LAYERS>,
+    volumes: array<FieldVolume, MAX_VOLUMES>,
+    hiheight_levels: array<vec4<u32>, MAX_HIHEIGHT_LEVELS>, // per level: first cell, width, height
 }
 
 @group(0) @binding(0) var<uniform> field: Field;
@@ -42,23 +59,23 @@ const FIELD_NO_HIT: f32 = 3.0e38;
 
 // Unit "up" at p: the planet normal (or +y on a flat planet).
 fn field_up(p: vec3<f32>) -> vec3<f32> {
-    if field.planet.y > 0.5 {
+    if field.flat_planet == 1u {
         return vec3<f32>(0.0, 1.0, 0.0);
     }
-    return normalize(vec3<f32>(p.x, p.y + field.planet.x, p.z));
+    return normalize(vec3<f32>(p.x, p.y + field.planet_radius_m, p.z));
 }
 
 // Ray parameters (t0, t1) where the ray o + t d is below altitude `h` (inside the sphere of radius
 // R + h, or under the plane y = h); t0 > t1 when it never is.
 fn field_below(o: vec3<f32>, d: vec3<f32>, h: f32) -> vec2<f32> {
-    if field.planet.y > 0.5 {
+    if field.flat_planet == 1u {
         if abs(d.y) < 1.0e-8 {
             return select(vec2<f32>(1.0, -1.0), vec2<f32>(-FIELD_NO_HIT, FIELD_NO_HIT), o.y < h);
         }
         let t = (h - o.y) / d.y;
         return select(vec2<f32>(t, FIELD_NO_HIT), vec2<f32>(-FIELD_NO_HIT, t), d.y > 0.0);
     }
-    let r = field.planet.x;
+    let r = field.planet_radius_m;
     let b = dot(o, d) + d.y * r;
     // |o - c|^2 - (R + h)^2 without cancellation: |o|^2 + 2 o.y R - h (2 R + h).
     let c = dot(o, o) + 2.0 * o.y * r - h * (2.0 * r + h);
@@ -88,33 +105,28 @@ fn field_remap(value: f32, lo0: f32, hi0: f32, lo1: f32, hi1: f32) -> f32 {
 
 // Altitude above the ground (m); the cancellation-free sphere form of PlanetGeometry::altitude_m.
 fn field_altitude_m(p: vec3<f32>) -> f32 {
-    let r = field.planet.x;
-    if field.planet.y > 0.5 {
+    let r = field.planet_radius_m;
+    if field.flat_planet == 1u {
         return p.y;
     }
     let to_centre = length(vec3<f32>(p.x, p.y + r, p.z));
     return (dot(p, p) + 2.0 * p.y * r) / (to_centre + r);
 }
 
+// The density-height gradient: profile::height_gradient over TYPE_GRADIENTS (generated from Rust).
 fn field_height_gradient(type_coord: f32, f: f32) -> f32 {
     let t = clamp(type_coord, 0.0, 3.0);
     let lo = min(u32(floor(t)), 2u);
     let w = t - f32(lo);
-    var gradients = array<vec4<f32>, 4>(
-        vec4<f32>(0.0, 0.07, 0.08, 0.15),
-        vec4<f32>(0.0, 0.2, 0.42, 0.6),
-        vec4<f32>(0.0, 0.1, 0.2, 1.0),
-        vec4<f32>(0.0, 0.05, 0.9, 1.0),
-    );
-    let g = gradients[lo] * (1.0 - w) + gradients[lo + 1u] * w;
+    let g = TYPE_GRADIENTS[lo] * (1.0 - w) + TYPE_GRADIENTS[lo + 1u] * w;
     let rise = clamp(field_remap(f, g.x, g.y, 0.0, 1.0), 0.0, 1.0);
     let fall = clamp(field_remap(f, g.z, g.w, 1.0, 0.0), 0.0, 1.0);
     return rise * fall;
 }
 
 fn field_type_coord(layer: FieldLayer, channel: f32) -> f32 {
-    let e = 0.05;
-    var t = layer.noise_offset.w;
+    let e = TYPE_BLEND_HALF_WIDTH;
+    var t = layer.type_first;
     for (var i = 0u; i < 3u; i++) {
         t += layer.type_steps[i] * smoothstep(layer.type_bounds[i] - e, layer.type_bounds[i] + e, channel);
     }
@@ -138,14 +150,14 @@ fn field_erode(density: f32, detail: vec4<f32>, f: f32, erosion: f32) -> f32 {
 }
 
 fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32, eroded: bool) -> f32 {
-    let f = (h - layer.shape.x) / layer.shape.y;
+    let f = (h - layer.bottom_m) / layer.thickness_m;
     if f < 0.0 || f > 1.0 {
         return 0.0;
     }
-    let wind = layer.motion.xy * field.weather.z;
+    let wind = layer.wind_m_per_s * field.time_s;
     let xz = p.xz - wind;
-    let w = textureSampleLevel(field_weather_map, field_repeat_linear, xz / field.weather.xy + layer.motion.zw, 0.0);
-    let coverage = clamp(w.x + 2.0 * layer.shape.z - 1.0, 0.0, 1.0);
+    let w = textureSampleLevel(field_weather_map, field_repeat_linear, xz / field.weather_extent_m + layer.weather_offset, 0.0);
+    let coverage = clamp(w.x + 2.0 * layer.coverage - 1.0, 0.0, 1.0);
     if coverage <= 0.0 {
         return 0.0;
     }
@@ -154,8 +166,8 @@ fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32, eroded: bool)
     if gradient <= 0.0 {
         return 0.0;
     }
-    let q = p - vec3<f32>(wind.x, 0.0, wind.y) + layer.noise_offset.xyz;
-    let base = textureSampleLevel(field_base_noise, field_repeat_linear, q / field.noise.x, 0.0);
+    let q = p - vec3<f32>(wind.x, 0.0, wind.y) + layer.noise_offset_m;
+    let base = textureSampleLevel(field_base_noise, field_repeat_linear, q / field.base_noise_period_m, 0.0);
     let fbm = base.y * 0.625 + base.z * 0.25 + base.w * 0.125;
     let shaped = field_remap(base.x, fbm - 1.0, 1.0, 0.0, 1.0) * gradient;
     let covered = field_apply_coverage(shaped, coverage, type_coord, f);
@@ -163,31 +175,31 @@ fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32, eroded: bool)
         return 0.0;
     }
     if !eroded {
-        return min(covered, 1.0) * w.z * layer.shape.w;
+        return min(covered, 1.0) * w.z * layer.extinction_per_m;
     }
-    let curl = textureSampleLevel(field_curl_noise, field_repeat_linear, q.xz / field.noise.x, 0.0);
-    let swirl = (curl.xy * 2.0 - 1.0) * field.noise.w * (1.0 - f);
-    let detail = textureSampleLevel(field_detail_noise, field_repeat_linear, (q + vec3<f32>(swirl.x, 0.0, swirl.y)) / field.noise.y, 0.0);
-    return field_erode(covered, detail, f, field.noise.z) * w.z * layer.shape.w;
+    let curl = textureSampleLevel(field_curl_noise, field_repeat_linear, q.xz / field.base_noise_period_m, 0.0);
+    let swirl = (curl.xy * 2.0 - 1.0) * field.curl_displacement_m * (1.0 - f);
+    let detail = textureSampleLevel(field_detail_noise, field_repeat_linear, (q + vec3<f32>(swirl.x, 0.0, swirl.y)) / field.detail_noise_period_m, 0.0);
+    return field_erode(covered, detail, f, field.detail_erosion) * w.z * layer.extinction_per_m;
 }
 
 fn field_volume_extinction(v: FieldVolume, p: vec3<f32>) -> f32 {
-    let uvw = (p - v.min_m.xyz) / v.size_m.xyz;
+    let uvw = (p - v.min_m) / v.size_m;
     if any(uvw < vec3<f32>(0.0)) || any(uvw > vec3<f32>(1.0)) {
         return 0.0;
     }
-    let texel = clamp(uvw * v.resolution.xyz, vec3<f32>(0.5), v.resolution.xyz - 0.5);
-    let atlas_uvw = (v.atlas_origin.xyz + texel) / field.atlas_size.xyz;
-    return textureSampleLevel(field_volume_atlas, field_clamp_linear, atlas_uvw, 0.0).x * v.min_m.w;
+    let texel = clamp(uvw * v.resolution_texels, vec3<f32>(0.5), v.resolution_texels - 0.5);
+    let atlas_uvw = (vec3<f32>(0.0, 0.0, v.atlas_first_slice) + texel) / vec3<f32>(textureDimensions(field_volume_atlas));
+    return textureSampleLevel(field_volume_atlas, field_clamp_linear, atlas_uvw, 0.0).x * v.extinction_per_m;
 }
 
 fn field_extinction_detail(p: vec3<f32>, eroded: bool) -> f32 {
     let h = field_altitude_m(p);
     var sigma_t = 0.0;
-    for (var i = 0u; i < field.counts.x; i++) {
+    for (var i = 0u; i < field.layer_count; i++) {
         sigma_t += field_layer_extinction(field.layers[i], p, h, eroded);
     }
-    for (var i = 0u; i < field.counts.y; i++) {
+    for (var i = 0u; i < field.volume_count; i++) {
         sigma_t += field_volume_extinction(field.volumes[i], p);
     }
     return sigma_t;
@@ -205,11 +217,11 @@ fn field_extinction_coarse(p: vec3<f32>) -> f32 {
 
 // The first stretch of the ray, within [0, t_max], inside the layers' altitude band.
 fn field_layer_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
-    if field.counts.x == 0u {
+    if field.layer_count == 0u {
         return vec2<f32>(1.0, -1.0);
     }
-    let outer = field_below(o, d, field.planet.w);
-    let inner = field_below(o, d, field.planet.z);
+    let outer = field_below(o, d, field.layer_top_m);
+    let inner = field_below(o, d, field.layer_bottom_m);
     var t0 = max(outer.x, 0.0);
     var t1 = min(outer.y, t_max);
     if inner.x < inner.y {
@@ -225,11 +237,11 @@ fn field_layer_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
 // The hull of the ray's stretches inside the voxel-grid boxes.
 fn field_volume_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
     var hull = vec2<f32>(FIELD_NO_HIT, -FIELD_NO_HIT);
-    for (var i = 0u; i < field.counts.y; i++) {
+    for (var i = 0u; i < field.volume_count; i++) {
         let v = field.volumes[i];
         let inv = 1.0 / d;
-        let a = (v.min_m.xyz - o) * inv;
-        let b = (v.min_m.xyz + v.size_m.xyz - o) * inv;
+        let a = (v.min_m - o) * inv;
+        let b = (v.min_m + v.size_m - o) * inv;
         let t0 = max(max(max(min(a.x, b.x), min(a.y, b.y)), min(a.z, b.z)), 0.0);
         let t1 = min(min(min(max(a.x, b.x), max(a.y, b.y)), max(a.z, b.z)), t_max);
         if t0 < t1 {
@@ -242,7 +254,8 @@ fn field_volume_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
 // Optical depth of the coarse (uneroded) field along p + t dir over t in [span.x, span.x + span.y],
 // from n segments whose lengths grow by the factor span.z from one to the next (2: Schneider 2015's
 // doubling light samples, fine near p; 1: uniform), each sampled at a jittered point; the segments'
-// offsets are decorrelated from `jitter` and from each other by the golden ratio.
+// offsets are decorrelated from `jitter` and from each other by the golden ratio:
+// CloudField::coarse_optical_depth.
 fn field_optical_depth_coarse(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: u32, jitter: f32) -> f32 {
     var total = f32(n);
     if span.z != 1.0 {
@@ -252,7 +265,7 @@ fn field_optical_depth_coarse(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: 
     var start = span.x;
     var tau = 0.0;
     for (var k = 0u; k < n; k++) {
-        let offset = fract(jitter + f32(k + 1u) * 0.618034);
+        let offset = fract(jitter + f32(k + 1u) * GOLDEN_RATIO_CONJUGATE);
         tau += field_extinction_coarse(p + dir * (start + width * offset)) * width;
         start += width;
         width *= span.z;

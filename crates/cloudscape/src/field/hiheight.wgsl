@@ -1,3 +1,4 @@
+#import field
 // Hi-height traversal (field/hiheight.rs builds the pyramid): how far along a ray the layers are
 // provably empty, stepping up and down the max pyramid as hi-Z screen-space reflections do.
 
@@ -11,8 +12,8 @@ fn hiheight_cell(layer: FieldLayer, channel: u32, o: vec3<f32>, d: vec3<f32>, p:
     let info = field.hiheight_levels[level];
     let base = field.hiheight_levels[0];
     let dims0 = vec2<i32>(i32(base.y), i32(base.z));
-    let wind = layer.motion.xy * field.weather.z;
-    let uv = (p.xz - wind) / field.weather.xy + layer.motion.zw;
+    let wind = layer.wind_m_per_s * field.time_s;
+    let uv = (p.xz - wind) / field.weather_extent_m + layer.weather_offset;
     let cell0 = vec2<i32>(floor(uv * vec2<f32>(dims0) - 0.5));
     let wrapped = ((cell0 % dims0) + dims0) % dims0;
     let cell = wrapped >> vec2<u32>(level);
@@ -20,9 +21,9 @@ fn hiheight_cell(layer: FieldLayer, channel: u32, o: vec3<f32>, d: vec3<f32>, p:
     // The level-0 cells this cell covers, unwrapped around cell0, then in world metres.
     let lo = cell0 - wrapped + (cell << vec2<u32>(level));
     let hi = cell0 - wrapped + min((cell + 1) << vec2<u32>(level), dims0);
-    let to_world = field.weather.xy / vec2<f32>(dims0);
-    let world_lo = (vec2<f32>(lo) + 0.5 - layer.motion.zw * vec2<f32>(dims0)) * to_world + wind;
-    let world_hi = (vec2<f32>(hi) + 0.5 - layer.motion.zw * vec2<f32>(dims0)) * to_world + wind;
+    let to_world = field.weather_extent_m / vec2<f32>(dims0);
+    let world_lo = (vec2<f32>(lo) + 0.5 - layer.weather_offset * vec2<f32>(dims0)) * to_world + wind;
+    let world_hi = (vec2<f32>(hi) + 0.5 - layer.weather_offset * vec2<f32>(dims0)) * to_world + wind;
     let inv = 1.0 / d.xz;
     let exits = select((world_lo - o.xz) * inv, (world_hi - o.xz) * inv, d.xz > vec2<f32>(0.0));
     let exit_x = select(exits.x, FIELD_NO_HIT, abs(d.x) < 1.0e-9);
@@ -44,7 +45,7 @@ fn hiheight_descent_t(o: vec3<f32>, d: vec3<f32>, t: f32, top_m: f32) -> f32 {
 // The layers hold no cloud on [t, field_empty_until(o, d, t, t_end)): climbs the pyramid while
 // the ray's cells are empty and steps down where they may hold cloud, until a level-0 cell may.
 fn field_empty_until(o: vec3<f32>, d: vec3<f32>, t: f32, t_end: f32) -> f32 {
-    let levels = field.counts.z;
+    let levels = field.hiheight_level_count;
     var level = min(4u, levels - 1u);
     var t_cur = t;
     for (var iteration = 0u; iteration < 32u; iteration++) {
@@ -57,7 +58,7 @@ fn field_empty_until(o: vec3<f32>, d: vec3<f32>, t: f32, t_end: f32) -> f32 {
         let h = field_altitude_m(p);
         var empty = true;
         var exit = FIELD_NO_HIT;
-        for (var i = 0u; i < field.counts.x; i++) {
+        for (var i = 0u; i < field.layer_count; i++) {
             let cell = hiheight_cell(field.layers[i], i, o, d, p, level);
             exit = min(exit, cell.exit_t);
             if h <= cell.top_m {

@@ -25,6 +25,10 @@ use glam::{Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+/// `(sqrt(5) - 1) / 2`: successive multiples modulo 1 spread evenly (Weyl's sequence), so the
+/// segments of a light path sample decorrelated offsets.
+pub const GOLDEN_RATIO_CONJUGATE: f32 = 0.618034;
+
 /// Most cloud layers one field holds (the GPU uniform's array size).
 pub const MAX_LAYERS: usize = 4;
 /// Most voxel grids one field holds.
@@ -232,6 +236,33 @@ impl CloudField {
     /// and an upper bound of [`CloudField::extinction_per_m`] (erosion only removes density).
     pub fn coarse_extinction_per_m(&self, p: Vec3, time_s: f32) -> f32 {
         self.extinction(p, time_s, Detail::Coarse)
+    }
+
+    /// Optical depth of the coarse field along `p + t dir` over `t` in `[start_m, start_m +
+    /// length_m]`, from `n` segments whose lengths grow by `growth` from one to the next (2:
+    /// Schneider 2015's doubling light samples, fine near `p`; 1: uniform), each sampled at a point
+    /// offset by `jitter` and decorrelated from the others by the golden ratio:
+    /// `field_optical_depth_coarse` in `field.wgsl`.
+    pub fn coarse_optical_depth(
+        &self,
+        (p, dir): (Vec3, Vec3),
+        (start_m, length_m, growth): (f32, f32, f32),
+        (n, jitter): (u32, f32),
+        time_s: f32,
+    ) -> f32 {
+        let total = if growth == 1.0 {
+            n as f32
+        } else {
+            (growth.powi(n as i32) - 1.0) / (growth - 1.0)
+        };
+        let (mut width, mut start, mut tau) = (length_m / total, start_m, 0.0);
+        for k in 0..n {
+            let offset = (jitter + (k + 1) as f32 * GOLDEN_RATIO_CONJUGATE).fract();
+            tau += self.coarse_extinction_per_m(p + dir * (start + width * offset), time_s) * width;
+            start += width;
+            width *= growth;
+        }
+        tau
     }
 
     fn extinction(&self, p: Vec3, time_s: f32, detail: Detail) -> f32 {

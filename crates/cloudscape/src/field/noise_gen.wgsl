@@ -1,3 +1,4 @@
+#import noise
 // Fills a storage buffer with one noise texture's 8-bit RGBA texels (kind 0 base, 1 detail,
 // 2 curl), rows padded to `row_pitch_texels`, ready for copy_buffer_to_texture. Writing through a
 // buffer rather than a 3D storage texture keeps the GL backend working (wgpu-and-crates.md).
@@ -10,8 +11,8 @@ struct NoiseGenParams {
     depth: u32,
 }
 
-@group(0) @binding(0) var<uniform> noise_gen: NoiseGenParams;
-@group(0) @binding(1) var<storage, read_write> noise_texels: array<u32>;
+@group(3) @binding(0) var<uniform> noise_gen: NoiseGenParams;
+@group(3) @binding(1) var<storage, read_write> noise_texels: array<u32>;
 
 @compute @workgroup_size(4, 4, 4)
 fn generate_noise(@builtin(global_invocation_id) id: vec3<u32>) {

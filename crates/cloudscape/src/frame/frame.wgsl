@@ -1,43 +1,58 @@
-// One frame's camera and lighting: the twin of frame/mod.rs. Bound by each pass in its own group.
+#import constants noise
+// One frame's camera, ground and sampling grid: the twin of frame/mod.rs (FrameUniform member for
+// member). Bound once, at group 1, in every program that uses it.
 
 struct Frame {
     world_from_clip: mat4x4<f32>,
-    camera_position: vec4<f32>, // xyz (m), far distance (m)
-    viewport: vec4<f32>,        // width, height (px), time_s, frame index
-    sun_direction: vec4<f32>,   // unit vector toward the sun, cos(angular radius)
-    sun_irradiance: vec4<f32>,  // rgb irradiance facing the sun, angular radius (rad)
-    sky_zenith: vec4<f32>,      // rgb radiance straight up, gradient exponent
-    sky_horizon: vec4<f32>,     // rgb radiance at the horizon, haze extinction (m^-1)
-    sky_mean_up: vec4<f32>,     // rgb mean radiance over the upper hemisphere
-    ground_albedo: vec4<f32>,   // rgb albedo, 1 if there is a ground
-    ground_radiance: vec4<f32>, // rgb radiance leaving the unshadowed ground
-    cloud_optics: vec4<f32>,    // mean cosine g of the cloud droplets' phase function, 0, 0, 0
+    clip_from_world: mat4x4<f32>,   // for raster passes
+    camera_position_m: vec3<f32>,
+    far_m: f32,                     // nothing beyond this distance is marched
+    ground_albedo: vec3<f32>,       // Lambertian albedo (0 without a ground)
+    has_ground: u32,                // 1 when there is a ground
+    viewport_px: vec2<f32>,         // full-resolution width, height
+    time_s: f32,                    // scene time
+    frame_index: u32,               // decorrelates the jitter of successive frames
+    grid_subpixel: vec2<u32>,       // the pixel of each divisor x divisor block the output samples
+    grid_divisor: u32,              // 1, 2 or 4: output resolution is 1/divisor of the viewport
+    ray_offset_strata: f32,         // this frame's Halton offset along the rays, in strata
+    depth_far_value: f32,           // the host depth-buffer value where there is no geometry
+    depth_reversed: u32,            // 1 when nearer geometry stores larger depth values
+    cloud_mean_cosine: f32,         // mean cosine g of the cloud droplets' phase function
+    temporal_ray_offsets: u32,      // 1: ray offsets are Halton + Bayer (temporal reuse); 0: white noise
 }
 
-// Unit direction of the ray through pixel coordinates `pixel` (y down), as Frame::camera_ray.
-fn frame_ray_direction(frame: Frame, pixel: vec2<f32>) -> vec3<f32> {
-    let ndc = vec2<f32>(2.0 * pixel.x / frame.viewport.x - 1.0, 1.0 - 2.0 * pixel.y / frame.viewport.y);
-    let far = frame.world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
-    return normalize(far.xyz / far.w - frame.camera_position.xyz);
+@group(1) @binding(0) var<uniform> frame: Frame;
+
+// Normalised device xy of pixel coordinates `pixel` (y down).
+fn frame_ndc(pixel: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(2.0 * pixel.x / frame.viewport_px.x - 1.0, 1.0 - 2.0 * pixel.y / frame.viewport_px.y);
 }
 
-// Distance along the ray through `pixel` to the point a depth-buffer value `depth` (0 near, 1 far) stores.
-fn frame_depth_distance(frame: Frame, pixel: vec2<f32>, depth: f32) -> f32 {
-    let ndc = vec2<f32>(2.0 * pixel.x / frame.viewport.x - 1.0, 1.0 - 2.0 * pixel.y / frame.viewport.y);
-    let p = frame.world_from_clip * vec4<f32>(ndc, depth, 1.0);
-    return length(p.xyz / p.w - frame.camera_position.xyz);
+// Unit direction of the ray through pixel coordinates `pixel` (y down), as Frame::camera_ray: the
+// point at normalised depth 0.5 lies between the planes in every depth convention.
+fn frame_ray_direction(pixel: vec2<f32>) -> vec3<f32> {
+    let p = frame.world_from_clip * vec4<f32>(frame_ndc(pixel), 0.5, 1.0);
+    return normalize(p.xyz / p.w - frame.camera_position_m);
 }
 
-// Sky radiance from direction `dir`: SkyRadiance::radiance.
-fn frame_sky_radiance(frame: Frame, dir: vec3<f32>) -> vec3<f32> {
-    return mix(frame.sky_horizon.xyz, frame.sky_zenith.xyz, pow(max(dir.y, 0.0), frame.sky_zenith.w));
+// Whether a host depth-buffer value holds geometry (not the cleared value).
+fn frame_has_geometry(depth: f32) -> bool {
+    return select((depth < 1.0), (depth > 0.0), frame.depth_reversed == 1u);
 }
 
-// Radiance `radiance` seen from `distance_m` away through the haze: it fades toward the horizon
-// radiance as exp(-haze distance), weighted by `coverage` (1 - transmittance for clouds).
-fn frame_haze(frame: Frame, radiance: vec3<f32>, coverage: f32, distance_m: f32) -> vec3<f32> {
-    let clear = exp(-frame.sky_horizon.w * distance_m);
-    return radiance * clear + frame.sky_horizon.xyz * coverage * (1.0 - clear);
+// The farther of two depth-buffer values.
+fn frame_farther_depth(a: f32, b: f32) -> f32 {
+    return select(max(a, b), min(a, b), frame.depth_reversed == 1u);
+}
+
+// Distance along the ray through `pixel` to what depth-buffer value `depth` stores; FIELD-style
+// 3e38 where it holds no geometry: Frame::depth_distance_m.
+fn frame_depth_distance(pixel: vec2<f32>, depth: f32) -> f32 {
+    if !frame_has_geometry(depth) {
+        return 3.0e38;
+    }
+    let p = frame.world_from_clip * vec4<f32>(frame_ndc(pixel), depth, 1.0);
+    return length(p.xyz / p.w - frame.camera_position_m);
 }
 
 // A per-pixel, per-frame value in [0, 1): white noise from the PCG hash (noise.wgsl), which turns
@@ -49,7 +64,7 @@ fn frame_pixel_jitter(pixel: vec2<u32>, index: u32) -> f32 {
 // Eddington (two-stream) diffuse transmittance of a conservatively scattering slab of optical depth
 // tau: 1 / (1 + 3/4 (1 - g) tau) (e.g. Bohren 1987, "Multiple scattering of light and some of its
 // observable consequences", Am. J. Phys. 55): diffuse light is dimmed by the transport optical
-// depth (1 - g) tau, and only algebraically, not exponentially.
-fn frame_diffuse_transmittance(frame: Frame, tau: f32) -> f32 {
-    return 1.0 / (1.0 + 0.75 * (1.0 - frame.cloud_optics.x) * tau);
+// depth (1 - g) tau, and only algebraically, not exponentially. optics::diffuse_transmittance.
+fn frame_diffuse_transmittance(tau: f32) -> f32 {
+    return 1.0 / (1.0 + 0.75 * (1.0 - frame.cloud_mean_cosine) * tau);
 }

@@ -3,6 +3,7 @@
 //! - [`context`]: adapter choice and device creation, the only place that knows wgpu's set-up API.
 //! - [`readback`]: copying textures and buffers back to the CPU.
 //! - [`timing`]: per-pass GPU time from timestamp queries.
+//! - [`pipeline`]: compute and raster pipeline builders; [`uniform`]: a uniform in its own group.
 
 pub mod context;
 pub mod readback;
@@ -11,4 +12,8 @@ pub mod timing;
 pub use context::{Backend, GpuContext, GpuError, GpuOptions};
 pub use readback::{read_buffer, read_texture, read_texture_rgba16f, read_texture_rgba32f};
 pub use timing::PassTimer;
+pub mod late_readback;
+#[cfg(test)]
+pub(crate) mod layout_check;
 pub mod pipeline;
+pub mod uniform;

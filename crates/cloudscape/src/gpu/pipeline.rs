@@ -1,5 +1,5 @@
-//! Small builders for compute pipelines and bind group layouts, so each pass states only what it
-//! binds.
+//! Small builders for compute and raster pipelines, bind group layouts and bind groups, so each
+//! pass states only what it binds.
 
 use super::GpuContext;
 
@@ -89,7 +89,9 @@ pub fn storage_texture_2d(format: wgpu::TextureFormat) -> wgpu::BindingType {
     }
 }
 
-/// A compute-stage bind group layout whose binding `i` has type `types[i]`.
+/// A bind group layout whose binding `i` has type `types[i]`: read-only bindings are visible to
+/// compute, vertex and fragment stages, writable storage to compute (vertex stages cannot write
+/// storage without a native feature).
 pub fn bind_group_layout(
     device: &wgpu::Device,
     label: &str,
@@ -100,7 +102,7 @@ pub fn bind_group_layout(
         .enumerate()
         .map(|(i, ty)| wgpu::BindGroupLayoutEntry {
             binding: i as u32,
-            visibility: wgpu::ShaderStages::COMPUTE,
+            visibility: visibility(ty),
             ty: *ty,
             count: None,
         })
@@ -109,6 +111,22 @@ pub fn bind_group_layout(
         label: Some(label),
         entries: &entries,
     })
+}
+
+fn visibility(ty: &wgpu::BindingType) -> wgpu::ShaderStages {
+    let writable = match ty {
+        wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            ..
+        } => !read_only,
+        wgpu::BindingType::StorageTexture { .. } => true,
+        _ => false,
+    };
+    if writable {
+        wgpu::ShaderStages::COMPUTE
+    } else {
+        wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT
+    }
 }
 
 /// A bind group whose binding `i` is `resources[i]`.
@@ -132,32 +150,41 @@ pub fn bind_group(
     })
 }
 
-/// A compute pipeline from WGSL source with explicit bind group layouts (group `i` = `layouts[i]`).
+/// Bind group layouts of a pipeline by slot (group `i` = `layouts[i]`); None for a slot the
+/// program binds nothing at.
+pub type GroupLayouts<'a> = [Option<&'a wgpu::BindGroupLayout>];
+
+/// The shader module of a whole WGSL program ([`crate::shader::program`]).
+pub fn shader_module(ctx: &GpuContext, label: &str, source: &str) -> wgpu::ShaderModule {
+    ctx.device
+        .create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        })
+}
+
+fn pipeline_layout(ctx: &GpuContext, label: &str, layouts: &GroupLayouts) -> wgpu::PipelineLayout {
+    ctx.device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: layouts,
+            immediate_size: 0,
+        })
+}
+
+/// A compute pipeline from WGSL source with explicit bind group layouts.
 pub fn compute_pipeline(
     ctx: &GpuContext,
     label: &str,
     source: &str,
     entry: &str,
-    layouts: &[&wgpu::BindGroupLayout],
+    layouts: &GroupLayouts,
 ) -> wgpu::ComputePipeline {
-    let module = ctx
-        .device
-        .create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(label),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-    let groups: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(*l)).collect();
-    let layout = ctx
-        .device
-        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(label),
-            bind_group_layouts: &groups,
-            immediate_size: 0,
-        });
+    let module = shader_module(ctx, label, source);
     ctx.device
         .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(label),
-            layout: Some(&layout),
+            layout: Some(&pipeline_layout(ctx, label, layouts)),
             module: &module,
             entry_point: Some(entry),
             compilation_options: Default::default(),
@@ -165,12 +192,143 @@ pub fn compute_pipeline(
         })
 }
 
+/// A depth test against a host's depth buffer that never writes it (the attachment is read-only,
+/// so the same buffer can be bound as a texture elsewhere in the frame).
+#[derive(Clone, Copy, Debug)]
+pub struct DepthTest {
+    /// Format of the depth attachment.
+    pub format: wgpu::TextureFormat,
+    /// Which fragments pass: [`crate::frame::DepthConvention::compare`] keeps nearer ones.
+    pub compare: wgpu::CompareFunction,
+}
+
+/// What a raster pipeline draws: entry points, colour targets (format and blending) and an optional
+/// read-only depth test. Vertices come from the vertex shader (storage buffers, vertex index): no
+/// vertex buffers.
+pub struct RasterDescriptor<'a> {
+    /// Pipeline label.
+    pub label: &'a str,
+    /// The whole WGSL program.
+    pub source: &'a str,
+    /// Vertex and fragment entry points.
+    pub entries: (&'a str, &'a str),
+    /// Colour targets, e.g. premultiplied-alpha blending into a cloud output.
+    pub targets: &'a [Option<wgpu::ColorTargetState>],
+    /// Depth test, or None to draw everything.
+    pub depth: Option<DepthTest>,
+    /// Primitive topology.
+    pub topology: wgpu::PrimitiveTopology,
+}
+
+/// A render pipeline beside [`compute_pipeline`]: the same bind group slots, no vertex buffers.
+pub fn render_pipeline(
+    ctx: &GpuContext,
+    raster: &RasterDescriptor,
+    layouts: &GroupLayouts,
+) -> wgpu::RenderPipeline {
+    let module = shader_module(ctx, raster.label, raster.source);
+    let depth_stencil = raster.depth.map(|d| wgpu::DepthStencilState {
+        format: d.format,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(d.compare),
+        stencil: Default::default(),
+        bias: Default::default(),
+    });
+    ctx.device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(raster.label),
+            layout: Some(&pipeline_layout(ctx, raster.label, layouts)),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some(raster.entries.0),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: raster.topology,
+                ..Default::default()
+            },
+            depth_stencil,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(raster.entries.1),
+                compilation_options: Default::default(),
+                targets: raster.targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+}
+
+/// Premultiplied-alpha "over" blending of colour and alpha: `dst = src + (1 - src.a) dst`.
+pub const PREMULTIPLIED_OVER: wgpu::BlendState = wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING;
+
+/// A render pass into `color` (loaded or cleared), testing against `depth` read-only.
+pub fn begin_render_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    (color, load): (&wgpu::TextureView, wgpu::LoadOp<wgpu::Color>),
+    depth: Option<&wgpu::TextureView>,
+    timestamps: Option<wgpu::RenderPassTimestampWrites>,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: color,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load,
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: depth.map(|view| wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops: None,
+            stencil_ops: None,
+        }),
+        timestamp_writes: timestamps,
+        ..Default::default()
+    })
+}
+
+/// A bind group made once and remade only when the views it binds change (a resized target): no
+/// bind group is created per frame.
+#[derive(Default)]
+pub struct BindGroupCache {
+    views: Vec<wgpu::TextureView>,
+    group: Option<wgpu::BindGroup>,
+}
+
+impl BindGroupCache {
+    /// The bind group for `views`, made by `make` when they differ from last time.
+    pub fn get(
+        &mut self,
+        views: &[&wgpu::TextureView],
+        make: impl FnOnce() -> wgpu::BindGroup,
+    ) -> &wgpu::BindGroup {
+        let same =
+            self.views.len() == views.len() && self.views.iter().zip(views).all(|(a, b)| a == *b);
+        if !same || self.group.is_none() {
+            self.views = views.iter().map(|v| (*v).clone()).collect();
+            self.group = Some(make());
+        }
+        self.group.as_ref().expect("the group was just made")
+    }
+
+    /// Forgets the group (a buffer it binds was replaced).
+    pub fn clear(&mut self) {
+        self.group = None;
+    }
+}
+
 /// Records one compute pass over `size` pixels in 8x8 workgroups.
 pub fn dispatch_2d(
     encoder: &mut wgpu::CommandEncoder,
     label: &str,
     pipeline: &wgpu::ComputePipeline,
-    groups: &[&wgpu::BindGroup],
+    groups: &[Option<&wgpu::BindGroup>],
     size: glam::UVec2,
     timestamps: Option<wgpu::ComputePassTimestampWrites>,
 ) {
@@ -183,7 +341,7 @@ pub fn dispatch_2d_repeated(
     encoder: &mut wgpu::CommandEncoder,
     label: &str,
     pipeline: &wgpu::ComputePipeline,
-    groups: &[&wgpu::BindGroup],
+    groups: &[Option<&wgpu::BindGroup>],
     (size, times): (glam::UVec2, u32),
     timestamps: Option<wgpu::ComputePassTimestampWrites>,
 ) {
@@ -193,7 +351,9 @@ pub fn dispatch_2d_repeated(
     });
     pass.set_pipeline(pipeline);
     for (i, g) in groups.iter().enumerate() {
-        pass.set_bind_group(i as u32, *g, &[]);
+        if let Some(g) = g {
+            pass.set_bind_group(i as u32, *g, &[]);
+        }
     }
     for _ in 0..times {
         pass.dispatch_workgroups(size.x.div_ceil(8), size.y.div_ceil(8), 1);

@@ -1,4 +1,4 @@
-//! GPU time per compute pass, from timestamp queries written at the start and end of each pass.
+//! GPU time per compute or render pass, from timestamp queries written at the start and end of each pass.
 //!
 //! Use per frame: [`PassTimer::reset`], then [`PassTimer::compute_pass_writes`] for each pass to
 //! time (pass the result to [`wgpu::ComputePassDescriptor::timestamp_writes`]), then
@@ -66,6 +66,23 @@ impl PassTimer {
     ) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
         let index = self.reserve(label)?;
         self.queries.as_ref().map(|q| pass_writes(&q.set, index))
+    }
+
+    /// Timestamp writes for the next render pass, recorded under `label`: raster passes (sprites,
+    /// particle splats) are timed like compute passes.
+    pub fn render_pass_writes(
+        &mut self,
+        label: &str,
+    ) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        let index = self.reserve(label)?;
+        self.queries.as_ref().map(|q| {
+            let c = pass_writes(&q.set, index);
+            wgpu::RenderPassTimestampWrites {
+                query_set: c.query_set,
+                beginning_of_pass_write_index: c.beginning_of_pass_write_index,
+                end_of_pass_write_index: c.end_of_pass_write_index,
+            }
+        })
     }
 
     /// Timestamp writes for two passes encoded by one call (a pass and the pass that consumes it).

@@ -1,10 +1,10 @@
+#import constants
 // Phase functions of cloud droplets: the GPU twin of optics/phase.rs (same formulas, same names).
 //
 // Sign convention: cos_theta = dot(direction light travels before scattering, direction after),
 // so forward scattering is cos_theta = 1. Values are per steradian.
-// Functions only (no bindings, no entry points): this file is concatenated with others.
+// Functions only (no bindings, no entry points).
 
-const PHASE_PI: f32 = 3.14159265358979;
 
 // Henyey-Greenstein (Henyey & Greenstein 1941): (1 - g^2) / (4 pi (1 + g^2 - 2 g mu)^(3/2)).
 // The denominator is written as a sum of non-negative terms, (1 - g)^2 + 2 g (1 - mu) for g >= 0
@@ -13,7 +13,7 @@ fn phase_hg(g: f32, cos_theta: f32) -> f32 {
     let forward = (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - cos_theta);
     let backward = (1.0 + g) * (1.0 + g) - 2.0 * g * (1.0 + cos_theta);
     let denom = select(backward, forward, g >= 0.0);
-    return (1.0 - g * g) / (4.0 * PHASE_PI * denom * sqrt(denom));
+    return (1.0 - g * g) / (4.0 * PI * denom * sqrt(denom));
 }
 
 // Draine (Draine 2003): HG(g, mu) (1 + alpha mu^2) / (1 + alpha (1 + 2 g^2) / 3).

@@ -1,19 +1,14 @@
-// Puts the clouds over the background this crate draws when there is no host scene: the sky, the
-// sun's disc and the ground in the clouds' shadows. final = background * transmittance + cloud
-// radiance.
+#import field frame environment
+// Composes the cloud output over what lies behind it: the host's geometry where its depth buffer
+// holds some, else the sky, the sun's disc and the ground in the clouds' shadows. Aerial
+// perspective is applied here, once: to the background at its distance and to the clouds at their
+// distance. final = background * transmittance + hazed cloud radiance.
 
-@group(1) @binding(0) var<uniform> frame: Frame;
-@group(1) @binding(1) var compose_clouds: texture_2d<f32>;
-@group(1) @binding(2) var compose_out: texture_storage_2d<rgba16float, write>;
-
-// Radiance of the sun's disc, a uniform disc of the sun's irradiance: E / (pi r^2) for small r.
-fn compose_sun_disc(d: vec3<f32>) -> vec3<f32> {
-    if dot(d, frame.sun_direction.xyz) < frame.sun_direction.w {
-        return vec3<f32>(0.0);
-    }
-    let r = frame.sun_irradiance.w;
-    return frame.sun_irradiance.xyz / (3.14159265 * r * r);
-}
+@group(3) @binding(0) var compose_clouds: texture_2d<f32>;
+@group(3) @binding(1) var compose_cloud_distance: texture_2d<f32>;
+@group(3) @binding(2) var compose_host_color: texture_2d<f32>;
+@group(3) @binding(3) var compose_host_depth: texture_2d<f32>;
+@group(3) @binding(4) var compose_out: texture_storage_2d<rgba16float, write>;
 
 // Samples of the coarse optical depth from the ground through the layers, and again through the
 // voxel-grid boxes: uniform segments (unlike the march's doubling ones, which are fine near a point
@@ -39,33 +34,45 @@ fn compose_optical_depth(g: vec3<f32>, dir: vec3<f32>, jitter: f32) -> f32 {
 // Radiance leaving the Lambertian ground at g: the sun's and the sky's share of ground_radiance,
 // each dimmed by the clouds' diffuse transmittance between the ground and the light (the sun's
 // along its slant path: the direct beam and the light the clouds scatter forward, most of it
-// within a few degrees of the sun), as the path tracer's ground sees them through the same field.
+// within a few degrees of the sun), as the path tracer's ground sees them through the same field:
+// environment_ground_radiance, shadowed.
 fn compose_ground(g: vec3<f32>, jitter: f32) -> vec3<f32> {
-    let sun = frame.sun_direction.xyz;
-    let sun_part = frame.ground_albedo.xyz / 3.14159265 * frame.sun_irradiance.xyz * max(sun.y, 0.0);
-    let sky_part = frame.ground_radiance.xyz - sun_part;
+    let sun = environment_sun_direction();
+    let sun_part = frame.ground_albedo / PI * environment_sun_irradiance(g) * max(sun.y, 0.0);
+    let sky_part = frame.ground_albedo / PI * environment_sky_irradiance_up(g);
     var sun_t = 0.0;
     if sun.y > 0.0 {
-        sun_t = frame_diffuse_transmittance(frame, compose_optical_depth(g, sun, jitter));
+        sun_t = frame_diffuse_transmittance(compose_optical_depth(g, sun, jitter));
     }
-    let sky_t = frame_diffuse_transmittance(frame, compose_optical_depth(g, field_up(g), jitter));
+    let sky_t = frame_diffuse_transmittance(compose_optical_depth(g, field_up(g), jitter));
     return sun_part * sun_t + sky_part * sky_t;
 }
 
+// What lies behind the clouds along the ray through pixel `px`, as the eye sees it through the haze.
+fn compose_background(px: vec2<u32>) -> vec3<f32> {
+    let pixel = vec2<f32>(px) + 0.5;
+    let o = frame.camera_position_m;
+    let d = frame_ray_direction(pixel);
+    let host_depth = textureLoad(compose_host_depth, vec2<i32>(px), 0).x;
+    if frame_has_geometry(host_depth) {
+        let host = textureLoad(compose_host_color, vec2<i32>(px), 0).rgb;
+        return environment_aerial_perspective(host, 1.0, frame_depth_distance(pixel, host_depth));
+    }
+    let ground_m = field_ground_distance(o, d, frame.has_ground == 1u);
+    if ground_m < frame.far_m {
+        let jitter = frame_pixel_jitter(px, frame.frame_index);
+        return environment_aerial_perspective(compose_ground(o + d * ground_m, jitter), 1.0, ground_m);
+    }
+    return environment_sky_radiance(d) + environment_sun_disc_radiance(d);
+}
+
 @compute @workgroup_size(8, 8)
-fn compose_background(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= u32(frame.viewport.x) || id.y >= u32(frame.viewport.y) {
+fn compose_clouds_over_background(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= u32(frame.viewport_px.x) || id.y >= u32(frame.viewport_px.y) {
         return;
     }
-    let pixel = vec2<f32>(id.xy) + 0.5;
-    let o = frame.camera_position.xyz;
-    let d = frame_ray_direction(frame, pixel);
-    var background = frame_sky_radiance(frame, d) + compose_sun_disc(d);
-    let ground_m = field_ground_distance(o, d, frame.ground_albedo.w > 0.5);
-    if ground_m < frame.camera_position.w {
-        let jitter = frame_pixel_jitter(id.xy, u32(frame.viewport.w));
-        background = frame_haze(frame, compose_ground(o + d * ground_m, jitter), 1.0, ground_m);
-    }
     let clouds = textureLoad(compose_clouds, vec2<i32>(id.xy), 0);
-    textureStore(compose_out, vec2<i32>(id.xy), vec4<f32>(background * clouds.a + clouds.rgb, 1.0));
+    let distance_m = textureLoad(compose_cloud_distance, vec2<i32>(id.xy), 0).x;
+    let hazed = environment_aerial_perspective(clouds.rgb, 1.0 - clouds.a, distance_m);
+    textureStore(compose_out, vec2<i32>(id.xy), vec4<f32>(compose_background(id.xy) * clouds.a + hazed, 1.0));
 }

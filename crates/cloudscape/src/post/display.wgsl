@@ -1,3 +1,4 @@
+#import tonemap
 // HDR radiance to display: exposure, tone mapping (tonemap.wgsl) and sRGB encoding.
 
 struct Display {
@@ -5,9 +6,9 @@ struct Display {
     tonemap_operator: u32, // 0 ACES, 1 AgX
 }
 
-@group(0) @binding(0) var<uniform> display: Display;
-@group(0) @binding(1) var display_hdr: texture_2d<f32>;
-@group(0) @binding(2) var display_out: texture_storage_2d<rgba8unorm, write>;
+@group(3) @binding(0) var<uniform> display: Display;
+@group(3) @binding(1) var display_hdr: texture_2d<f32>;
+@group(3) @binding(2) var display_out: texture_storage_2d<rgba8unorm, write>;
 
 @compute @workgroup_size(8, 8)
 fn display_hdr_image(@builtin(global_invocation_id) id: vec3<u32>) {

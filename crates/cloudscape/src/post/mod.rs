@@ -1,107 +1,126 @@
-//! After the clouds: composing them over the sky, sun and ground, and tone mapping HDR radiance
-//! for display. Each is a compute pass with one entry type.
+//! After the technique and temporal reuse: composing the full-resolution cloud output over what
+//! lies behind it (the host's geometry, or the sky, sun and ground), with aerial perspective applied
+//! once, and tone mapping HDR radiance for display. Each is a compute pass with one entry type,
+//! made once; bind groups are remade only when the targets change.
 
 pub mod tonemap;
 
-use crate::field::gpu::{FIELD_WGSL, FieldGpu, NOISE_WGSL};
-use crate::frame::{FRAME_WGSL, Frame};
-use crate::gpu::GpuContext;
+use crate::frame::Shared;
 use crate::gpu::pipeline::{
-    UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d, float_texture,
-    storage_texture_2d, uniform_buffer,
+    BindGroupCache, UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d,
+    float_texture, storage_texture_2d, uniform_buffer,
 };
+use crate::gpu::{GpuContext, PassTimer};
+use crate::output::CloudOutput;
 use crate::scene::Tonemap;
-use wgpu::util::DeviceExt;
-
-const COMPOSE_WGSL: &str = include_str!("compose.wgsl");
-const DISPLAY_WGSL: &str = include_str!("display.wgsl");
+use bytemuck::{Pod, Zeroable};
+use glam::UVec2;
 
 /// Format of the composed HDR image.
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Format of the display image (sRGB-encoded values in a unorm texture, storage-writable everywhere).
 pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
-/// Source of the compose program.
-pub fn compose_source() -> String {
-    [NOISE_WGSL, FIELD_WGSL, FRAME_WGSL, COMPOSE_WGSL].concat()
+/// An unfilterable 2D float texture binding (depth buffers, R32Float, which GL cannot filter).
+const UNFILTERABLE_2D: wgpu::BindingType = wgpu::BindingType::Texture {
+    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+    view_dimension: wgpu::TextureViewDimension::D2,
+    multisampled: false,
+};
+
+/// What lies behind the clouds: the host's colour and depth at full resolution. Where the depth
+/// holds geometry its colour is the background; elsewhere the sky, sun and ground are.
+pub struct Background<'a> {
+    /// Host scene radiance (any float-sampled colour format).
+    pub color: &'a wgpu::TextureView,
+    /// Host depth buffer, in the frame's depth convention.
+    pub depth: &'a wgpu::TextureView,
 }
 
-/// Source of the display program.
-pub fn display_source() -> String {
-    [tonemap::TONEMAP_WGSL, DISPLAY_WGSL].concat()
-}
-
-/// Composes the cloud target over the sky, the sun's disc and the ground in the clouds' shadows.
-pub struct Background {
+/// Composes a full-resolution cloud output over the background: `background * a + hazed rgb`.
+pub struct Compositor {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
-    frame: wgpu::Buffer,
+    group: BindGroupCache,
 }
 
-impl Background {
-    /// Builds the pass against the field's bind group (for the planet's shape).
-    pub fn new(ctx: &GpuContext, field: &FieldGpu) -> Background {
+impl Compositor {
+    /// Builds the pass against the shared groups' layouts.
+    pub fn new(ctx: &GpuContext, shared: &Shared) -> Compositor {
         let d2 = wgpu::TextureViewDimension::D2;
         let layout = bind_group_layout(
             &ctx.device,
             "compose",
-            &[UNIFORM, float_texture(d2), storage_texture_2d(HDR_FORMAT)],
+            &[
+                float_texture(d2),
+                UNFILTERABLE_2D,
+                UNFILTERABLE_2D,
+                UNFILTERABLE_2D,
+                storage_texture_2d(HDR_FORMAT),
+            ],
         );
         let pipeline = compute_pipeline(
             ctx,
             "compose",
-            &compose_source(),
-            "compose_background",
-            &[field.layout(), &layout],
+            &crate::shader::program("compose"),
+            "compose_clouds_over_background",
+            &shared.layouts(&layout),
         );
-        let frame = uniform_buffer(
-            ctx,
-            "compose frame",
-            size_of::<crate::frame::FrameUniform>() as u64,
-        );
-        Background {
+        Compositor {
             pipeline,
             layout,
-            frame,
+            group: BindGroupCache::default(),
         }
     }
 
-    /// Records `hdr = background * clouds.a + clouds.rgb` for `frame`.
+    /// Records the composition of `clouds` over `background` into `hdr` ([`HDR_FORMAT`], storage).
     pub fn encode(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        field: &FieldGpu,
-        frame: &Frame,
-        (clouds, hdr): (&wgpu::TextureView, &wgpu::TextureView),
-        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+        shared: &Shared,
+        (clouds, background): (&CloudOutput, &Background),
+        hdr: &wgpu::TextureView,
+        timer: Option<&mut PassTimer>,
     ) {
-        ctx.queue
-            .write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame.uniform()));
-        let group = bind_group(
-            &ctx.device,
-            &self.layout,
-            &[
-                self.frame.as_entire_binding(),
-                wgpu::BindingResource::TextureView(clouds),
-                wgpu::BindingResource::TextureView(hdr),
-            ],
-        );
+        let views = [
+            &clouds.radiance,
+            &clouds.distance,
+            background.color,
+            background.depth,
+            hdr,
+        ];
+        let layout = &self.layout;
+        let group = self.group.get(&views, || {
+            let resources = views.map(|v| wgpu::BindingResource::TextureView(v));
+            bind_group(&ctx.device, layout, &resources)
+        });
+        let writes = timer.and_then(|t| t.compute_pass_writes("compose"));
         dispatch_2d(
             encoder,
             "compose",
             &self.pipeline,
-            &[field.bind_group(), &group],
-            frame.size,
-            timestamps,
+            &shared.bind_groups(group),
+            clouds.size,
+            writes,
         );
     }
+}
+
+/// The `Display` uniform of `display.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct DisplayUniform {
+    exposure_scale: f32,
+    tonemap_operator: u32,
 }
 
 /// Exposure, tone mapping and sRGB encoding into a [`DISPLAY_FORMAT`] texture.
 pub struct Display {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    uniform: wgpu::Buffer,
+    group: BindGroupCache,
 }
 
 impl Display {
@@ -119,47 +138,71 @@ impl Display {
         let pipeline = compute_pipeline(
             ctx,
             "display",
-            &display_source(),
+            &crate::shader::program("display"),
             "display_hdr_image",
-            &[&layout],
+            &[None, None, None, Some(&layout)],
         );
-        Display { pipeline, layout }
+        Display {
+            pipeline,
+            layout,
+            uniform: uniform_buffer(ctx, "display", size_of::<DisplayUniform>() as u64),
+            group: BindGroupCache::default(),
+        }
     }
 
-    /// Records the mapping of `hdr` into `out` (same size).
+    /// Records the mapping of `hdr` into `out` (both `size` pixels).
     pub fn encode(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        (hdr, out): (&wgpu::TextureView, &wgpu::TextureView),
-        size: glam::UVec2,
+        (hdr, out, size): (&wgpu::TextureView, &wgpu::TextureView, UVec2),
         (exposure_ev, operator): (f32, Tonemap),
-        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+        timer: Option<&mut PassTimer>,
     ) {
-        let params = [2f32.powf(exposure_ev).to_bits(), operator as u32, 0, 0];
-        let uniform = ctx
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("display"),
-                contents: bytemuck::cast_slice(&params),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-        let group = bind_group(
-            &ctx.device,
-            &self.layout,
-            &[
-                uniform.as_entire_binding(),
-                wgpu::BindingResource::TextureView(hdr),
-                wgpu::BindingResource::TextureView(out),
-            ],
-        );
+        let uniform = DisplayUniform {
+            exposure_scale: 2f32.powf(exposure_ev),
+            tonemap_operator: operator as u32,
+        };
+        ctx.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        let (layout, buffer) = (&self.layout, &self.uniform);
+        let group = self.group.get(&[hdr, out], || {
+            bind_group(
+                &ctx.device,
+                layout,
+                &[
+                    buffer.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(hdr),
+                    wgpu::BindingResource::TextureView(out),
+                ],
+            )
+        });
+        let writes = timer.and_then(|t| t.compute_pass_writes("display"));
         dispatch_2d(
             encoder,
             "display",
             &self.pipeline,
-            &[&group],
+            &[None, None, None, Some(group)],
             size,
-            timestamps,
+            writes,
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout_check::assert_wgsl_layout;
+
+    #[test]
+    fn display_uniform_matches_its_wgsl_layout() {
+        assert_wgsl_layout!(
+            "display",
+            "Display",
+            DisplayUniform {
+                exposure_scale,
+                tonemap_operator,
+            }
         );
     }
 }

@@ -1,5 +1,5 @@
 // Exposure, tone mapping and sRGB encoding: the GPU twin of post/tonemap.rs (same formulas).
-// Functions only (no bindings, no entry points): this file is concatenated with others.
+// Functions only (no bindings, no entry points).
 //
 // Matrices are written row by row as published and applied as `c * M`, which in WGSL's
 // column-major convention is the published `M c`.

@@ -1,39 +1,21 @@
 //! Ray-marched clouds (the volumecloud seed, with Schneider 2015 and Hillaire 2016): a compute pass
-//! that writes, per pixel, the radiance the clouds scatter toward the eye (rgb) and the transmittance
-//! through them (a), stopping at the host's depth buffer. Composite as `scene * a + rgb`.
+//! that writes, per output texel, the radiance the clouds scatter toward the eye, the transmittance
+//! through them and the cloud distance ([`crate::output`]), stopping at the host's depth buffer.
 
-use crate::field::gpu::{FIELD_WGSL, FieldGpu, NOISE_WGSL};
-use crate::frame::{FRAME_WGSL, Frame};
+use crate::frame::Shared;
 use crate::gpu::GpuContext;
+use crate::gpu::PassTimer;
+use crate::gpu::late_readback::LateReadback;
 use crate::gpu::pipeline::{
-    UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d_repeated,
+    BindGroupCache, UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d_repeated,
     storage_binding, storage_buffer, storage_texture_2d, uniform_buffer,
 };
-use crate::optics::{PHASE_WGSL, PhaseLobes};
+use crate::optics::PhaseLobes;
+use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
 use crate::scene::{Quality, Scene};
+use crate::technique::{Technique, TechniqueStats, TechniqueTargets};
 use bytemuck::{Pod, Zeroable};
-use glam::{UVec2, UVec4, Vec4};
-
-pub mod temporal;
-
-const RAYMARCH_WGSL: &str = include_str!("raymarch.wgsl");
-
-/// Format of the cloud target: rgb in-scattered radiance, a transmittance.
-pub const CLOUD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// Format of the cloud-depth target.
-pub const CLOUD_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
-
-/// Source of the ray-march program.
-pub fn shader_source() -> String {
-    [
-        NOISE_WGSL,
-        FIELD_WGSL,
-        FRAME_WGSL,
-        PHASE_WGSL,
-        RAYMARCH_WGSL,
-    ]
-    .concat()
-}
+use glam::{UVec2, Vec4};
 
 /// Step counts and lighting of the march.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,86 +74,79 @@ impl MarchSettings {
     }
 }
 
+/// The `March` uniform of `raymarch.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct MarchUniform {
-    counts: UVec4,
-    octaves: Vec4,
-    phase: Vec4,
-    ambient: Vec4,
-    tile: UVec4,
-    flags: UVec4,
-    grid: UVec4,
-    ray_offset: Vec4,
+    primary_steps: u32,
+    light_steps: u32,
+    samples_per_pixel: u32,
+    octaves: u32,
+    octave_attenuation: f32,
+    octave_contribution: f32,
+    octave_eccentricity: f32,
+    albedo: f32,
+    phase_lobes: Vec4,
+    ambient_scale: f32,
+    empty_space_skipping: u32,
+    tile_width: u32,
+    reserved0: u32,
+    tile_origin: UVec2,
+    reserved: UVec2,
 }
 
-/// Which rays a march traces: one per pixel of a grid at 1/`divisor` of the frame's resolution,
-/// through sub-pixel `subpixel` of each block, offset along the ray by white noise (stills) or by a
-/// frame's Halton value plus the seed's Bayer pattern (temporal reuse).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MarchGrid {
-    /// 1, 2 or 4: the grid has 1/divisor of the frame's pixels along each axis.
-    pub divisor: u32,
-    /// The pixel of each divisor x divisor block the rays go through.
-    pub subpixel: UVec2,
-    /// Halton offset along the rays, for temporal reuse; None for independent white noise.
-    pub temporal_offset: Option<f32>,
-}
-
-impl MarchGrid {
-    /// Every pixel, white-noise offsets: stills.
-    pub const FULL: MarchGrid = MarchGrid {
-        divisor: 1,
-        subpixel: UVec2::ZERO,
-        temporal_offset: None,
-    };
-
-    /// Grid size for a frame of `size` pixels.
-    pub fn size(&self, size: UVec2) -> UVec2 {
-        (size + self.divisor - 1) / self.divisor
+impl MarchUniform {
+    fn new(settings: &MarchSettings) -> MarchUniform {
+        let [a, b, c] = settings.octave_factors;
+        MarchUniform {
+            primary_steps: settings.primary_steps,
+            light_steps: settings.light_steps,
+            samples_per_pixel: settings.samples_per_pixel,
+            octaves: settings.octaves,
+            octave_attenuation: a,
+            octave_contribution: b,
+            octave_eccentricity: c,
+            albedo: settings.albedo,
+            phase_lobes: Vec4::from_array(settings.phase.to_gpu()),
+            ambient_scale: settings.ambient_scale,
+            empty_space_skipping: settings.empty_space_skipping as u32,
+            ..MarchUniform::zeroed()
+        }
     }
 }
 
-/// What the march did, counted on the GPU since the last [`RaymarchRenderer::prepare`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MarchStats {
-    /// Pixels marched.
-    pub pixels: u32,
-    /// Extinction evaluations along view rays, per marched pixel.
-    pub density_samples_per_pixel: f64,
+/// One pixel's running sums while the march is dispatched once per sample (`MarchSum`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct MarchSum {
+    radiance_transmittance: Vec4,
+    distance_m: f32,
+    samples: u32,
+    reserved: UVec2,
 }
-
-/// Where the march reads and writes.
-pub struct RaymarchTargets<'a> {
-    /// The host's depth buffer (Depth32Float, 0 near, 1 far, from `Frame::clip_from_view`).
-    pub depth: &'a wgpu::TextureView,
-    /// Output, [`CLOUD_FORMAT`] with STORAGE_BINDING, the march grid's size.
-    pub clouds: &'a wgpu::TextureView,
-    /// Output, [`CLOUD_DEPTH_FORMAT`] with STORAGE_BINDING, the march grid's size: the
-    /// transmittance-weighted distance to the cloud in metres (0 where there is none).
-    pub cloud_depth: &'a wgpu::TextureView,
-}
-
-/// The ray-march pass.
-pub struct RaymarchRenderer {
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
-    frame: wgpu::Buffer,
-    march: wgpu::Buffer,
-    stats: wgpu::Buffer,
-    sums: wgpu::Buffer,
-    settings: MarchUniform,
-}
-
-/// Bytes of one pixel's running sums (`MarchSum` in raymarch.wgsl).
-const MARCH_SUM_BYTES: u64 = 32;
 
 /// The counters' and sums' binding.
 const READ_WRITE: wgpu::BindingType = storage_binding(false);
 
+/// Bytes of the counters: view-ray density samples, texels marched.
+const STATS_BYTES: u64 = 8;
+
+/// The ray marcher: one compute pass, made once.
+pub struct RaymarchRenderer {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    march: wgpu::Buffer,
+    stats: wgpu::Buffer,
+    stats_readback: LateReadback,
+    sums: wgpu::Buffer,
+    group: BindGroupCache,
+    settings: MarchUniform,
+    stats_cleared: bool,
+}
+
 impl RaymarchRenderer {
-    /// Builds the pipeline against the field's bind group layout.
-    pub fn new(ctx: &GpuContext, field: &FieldGpu) -> RaymarchRenderer {
+    /// Builds the pipeline against the shared groups' layouts.
+    pub fn new(ctx: &GpuContext, shared: &Shared) -> RaymarchRenderer {
         let depth = wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Float { filterable: false },
             view_dimension: wgpu::TextureViewDimension::D2,
@@ -182,127 +157,162 @@ impl RaymarchRenderer {
             "raymarch",
             &[
                 UNIFORM,
-                UNIFORM,
                 depth,
                 storage_texture_2d(CLOUD_FORMAT),
                 READ_WRITE,
-                storage_texture_2d(CLOUD_DEPTH_FORMAT),
+                storage_texture_2d(CLOUD_DISTANCE_FORMAT),
                 READ_WRITE,
             ],
         );
         let pipeline = compute_pipeline(
             ctx,
             "raymarch",
-            &shader_source(),
+            &crate::shader::program("raymarch"),
             "march_clouds",
-            &[field.layout(), &layout],
+            &shared.layouts(&layout),
         );
-        let buffer = |label, size| uniform_buffer(ctx, label, size);
         RaymarchRenderer {
             pipeline,
             layout,
-            frame: buffer(
-                "raymarch frame",
-                size_of::<crate::frame::FrameUniform>() as u64,
-            ),
-            march: buffer("raymarch settings", size_of::<MarchUniform>() as u64),
-            stats: storage_buffer(ctx, "raymarch stats", 8),
-            sums: storage_buffer(ctx, "raymarch sums", MARCH_SUM_BYTES),
+            march: uniform_buffer(ctx, "raymarch settings", size_of::<MarchUniform>() as u64),
+            stats: storage_buffer(ctx, "raymarch stats", STATS_BYTES),
+            stats_readback: LateReadback::new(ctx, "raymarch stats readback", STATS_BYTES),
+            sums: storage_buffer(ctx, "raymarch sums", size_of::<MarchSum>() as u64),
+            group: BindGroupCache::default(),
             settings: MarchUniform::zeroed(),
+            stats_cleared: false,
         }
     }
 
-    /// Reads back the counters of the work submitted since the last `prepare` (waits for it).
-    pub fn stats(&self, ctx: &GpuContext) -> MarchStats {
-        let counts = crate::gpu::read_buffer::<u32>(ctx, &self.stats);
-        let (samples, pixels) = (counts[0], counts[1]);
-        MarchStats {
-            pixels,
-            density_samples_per_pixel: samples as f64 / pixels.max(1) as f64,
-        }
-    }
-
-    /// Uploads the frame and settings for the next [`RaymarchRenderer::encode`].
-    pub fn prepare(
-        &mut self,
-        ctx: &GpuContext,
-        frame: &Frame,
-        settings: &MarchSettings,
-        grid: &MarchGrid,
-    ) {
-        let [a, b, c] = settings.octave_factors;
-        self.settings = MarchUniform {
-            counts: UVec4::new(
-                settings.primary_steps,
-                settings.light_steps,
-                settings.samples_per_pixel,
-                settings.octaves,
-            ),
-            octaves: Vec4::new(a, b, c, settings.albedo),
-            phase: Vec4::from_array(settings.phase.to_gpu()),
-            ambient: Vec4::new(settings.ambient_scale, 0.0, 0.0, 0.0),
-            tile: UVec4::ZERO,
-            flags: UVec4::new(settings.empty_space_skipping as u32, 0, 0, 0),
-            grid: UVec4::new(
-                grid.divisor,
-                grid.subpixel.x,
-                grid.subpixel.y,
-                grid.temporal_offset.is_some() as u32,
-            ),
-            ray_offset: Vec4::new(grid.temporal_offset.unwrap_or(0.0), 0.0, 0.0, 0.0),
-        };
-        ctx.queue
-            .write_buffer(&self.stats, 0, bytemuck::bytes_of(&[0u32; 2]));
-        ctx.queue
-            .write_buffer(&self.frame, 0, bytemuck::bytes_of(&frame.uniform()));
+    /// Uploads the settings for the next [`Technique::encode`].
+    pub fn set_settings(&mut self, ctx: &GpuContext, settings: &MarchSettings) {
+        self.settings = MarchUniform::new(settings);
         ctx.queue
             .write_buffer(&self.march, 0, bytemuck::bytes_of(&self.settings));
     }
 
-    /// Records the march over the pixel rectangle at `origin` of `size` pixels (the whole frame, or
-    /// one tile of it so long renders can report progress between submissions), one dispatch per
-    /// sample per pixel. A tile's origin is uploaded now, so submit each tile before encoding the
-    /// next.
-    pub fn encode(
+    /// Makes the per-pixel sums buffer hold `texels` texels.
+    fn ensure_sums(&mut self, ctx: &GpuContext, texels: u32) {
+        let bytes = size_of::<MarchSum>() as u64 * u64::from(texels);
+        if self.settings.samples_per_pixel > 1 && self.sums.size() < bytes {
+            self.sums = storage_buffer(ctx, "raymarch sums", bytes);
+            self.group.clear();
+        }
+    }
+}
+
+impl Technique for RaymarchRenderer {
+    fn name(&self) -> &'static str {
+        "raymarch"
+    }
+
+    fn prepare(&mut self, ctx: &GpuContext, scene: &Scene) {
+        self.set_settings(ctx, &MarchSettings::from_scene(scene));
+    }
+
+    fn encode(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        field: &FieldGpu,
-        targets: &RaymarchTargets,
+        shared: &Shared,
+        targets: &TechniqueTargets,
         (origin, size): (UVec2, UVec2),
-        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+        timer: Option<(&mut PassTimer, &str)>,
     ) {
-        let tile = UVec4::new(origin.x, origin.y, size.x, 0);
-        if self.settings.tile != tile {
-            self.settings.tile = tile;
+        if !self.stats_cleared {
+            encoder.clear_buffer(&self.stats, 0, None);
+            self.stats_cleared = true;
+        }
+        if self.settings.tile_origin != origin || self.settings.tile_width != size.x {
+            self.settings.tile_origin = origin;
+            self.settings.tile_width = size.x;
             ctx.queue
                 .write_buffer(&self.march, 0, bytemuck::bytes_of(&self.settings));
         }
-        let samples = self.settings.counts.z;
-        let sums_bytes = MARCH_SUM_BYTES * u64::from(size.x * size.y);
-        if samples > 1 && self.sums.size() < sums_bytes {
-            self.sums = storage_buffer(ctx, "raymarch sums", sums_bytes);
-        }
-        let group = bind_group(
-            &ctx.device,
-            &self.layout,
-            &[
-                self.frame.as_entire_binding(),
-                self.march.as_entire_binding(),
-                wgpu::BindingResource::TextureView(targets.depth),
-                wgpu::BindingResource::TextureView(targets.clouds),
-                self.stats.as_entire_binding(),
-                wgpu::BindingResource::TextureView(targets.cloud_depth),
-                self.sums.as_entire_binding(),
-            ],
+        self.ensure_sums(ctx, size.x * size.y);
+        let (march, stats, sums, layout) = (&self.march, &self.stats, &self.sums, &self.layout);
+        let output = targets.output;
+        let group = self.group.get(
+            &[targets.host_depth, &output.radiance, &output.distance],
+            || {
+                bind_group(
+                    &ctx.device,
+                    layout,
+                    &[
+                        march.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(targets.host_depth),
+                        wgpu::BindingResource::TextureView(&output.radiance),
+                        stats.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(&output.distance),
+                        sums.as_entire_binding(),
+                    ],
+                )
+            },
         );
+        let writes = timer.and_then(|(t, label)| t.compute_pass_writes(label));
         dispatch_2d_repeated(
             encoder,
             "raymarch",
             &self.pipeline,
-            &[field.bind_group(), &group],
-            (size, samples),
-            timestamps,
+            &shared.bind_groups(group),
+            (size, self.settings.samples_per_pixel),
+            writes,
+        );
+    }
+
+    fn finish_frame(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        self.stats_readback.copy(encoder, &self.stats);
+        self.stats_cleared = false;
+    }
+
+    fn stats(&mut self, ctx: &GpuContext) -> Option<TechniqueStats> {
+        let bytes = self.stats_readback.latest(ctx)?;
+        let counts: &[u32] = bytemuck::cast_slice(bytes);
+        let (samples, pixels) = (counts[0], counts[1]);
+        Some(TechniqueStats {
+            pixels,
+            density_samples_per_pixel: f64::from(samples) / f64::from(pixels.max(1)),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout_check::assert_wgsl_layout;
+
+    #[test]
+    fn march_uniforms_match_their_wgsl_layouts() {
+        assert_wgsl_layout!(
+            "raymarch",
+            "March",
+            MarchUniform {
+                primary_steps,
+                light_steps,
+                samples_per_pixel,
+                octaves,
+                octave_attenuation,
+                octave_contribution,
+                octave_eccentricity,
+                albedo,
+                phase_lobes,
+                ambient_scale,
+                empty_space_skipping,
+                tile_width,
+                reserved0,
+                tile_origin,
+                reserved,
+            }
+        );
+        assert_wgsl_layout!(
+            "raymarch",
+            "MarchSum",
+            MarchSum {
+                radiance_transmittance,
+                distance_m,
+                samples,
+                reserved,
+            }
         );
     }
 }

@@ -1,34 +1,49 @@
-// Ray-marched clouds: per pixel, in-scattered radiance and transmittance of the cloud field along
-// the view ray, up to the host's depth buffer. Needs field.wgsl, frame.wgsl and optics/phase.wgsl.
+#import hiheight frame environment phase
+// Ray-marched clouds: per output texel, in-scattered radiance, transmittance and distance of the
+// cloud field along the view ray, up to the host's depth buffer (the cloud-output contract,
+// output/mod.rs). No haze: the compositor applies aerial perspective at the cloud distance.
 
 struct March {
-    counts: vec4<u32>,  // primary steps, light steps, samples per pixel, octaves
-    octaves: vec4<f32>, // attenuation a, contribution b, eccentricity c, single-scattering albedo
-    phase: vec4<f32>,   // phase lobes (optics::PhaseLobes::to_gpu)
-    ambient: vec4<f32>, // ambient scale, 0, 0, 0
-    tile: vec4<u32>,    // origin x, y of the pixel tile this dispatch covers, its width
-    flags: vec4<u32>,   // 1 to skip empty space with the hi-height pyramid
-    grid: vec4<u32>,    // divisor of the march grid, sub-pixel x, y updated this frame, 1 if temporal
-    ray_offset: vec4<f32>, // this frame's Halton offset along the rays (temporal)
+    primary_steps: u32,
+    light_steps: u32,           // samples toward the sun from each view sample
+    samples_per_pixel: u32,
+    octaves: u32,               // multiple-scattering octaves (Wrenninge 2013)
+    octave_attenuation: f32,    // a: extinction factor per octave
+    octave_contribution: f32,   // b: scattering factor per octave
+    octave_eccentricity: f32,   // c: phase asymmetry factor per octave
+    albedo: f32,                // single-scattering albedo
+    phase_lobes: vec4<f32>,     // optics::PhaseLobes::to_gpu (g_hg, g_draine, alpha, w_draine)
+    ambient_scale: f32,         // scale of sky and ground light
+    empty_space_skipping: u32,  // 1 to skip empty space with the hi-height pyramid
+    tile_width: u32,            // width of the texel band this dispatch covers
+    reserved0: u32,
+    tile_origin: vec2<u32>,     // first texel of the band
+    reserved: vec2<u32>,
 }
 
 struct MarchResult {
     radiance: vec3<f32>,
     transmittance: f32,
     density_samples: u32, // view-ray extinction evaluations
-    depth_m: f32,         // transmittance-weighted mean distance of the cloud, 0 without cloud
+    distance_m: f32,      // transmittance-weighted mean distance of the cloud, 0 without cloud
 }
 
-@group(1) @binding(0) var<uniform> frame: Frame;
-@group(1) @binding(1) var<uniform> march: March;
+// Running sums of one pixel's samples while the pass is dispatched once per sample.
+struct MarchSum {
+    radiance_transmittance: vec4<f32>,
+    distance_m: f32,
+    samples: u32, // samples summed so far
+    reserved: vec2<u32>,
+}
+
+@group(3) @binding(0) var<uniform> march: March;
 // The host's depth buffer, bound as unfilterable float (GLSL cannot load from depth samplers).
-@group(1) @binding(2) var host_depth: texture_2d<f32>;
-@group(1) @binding(3) var cloud_out: texture_storage_2d<rgba16float, write>;
-// Counters over the dispatch: [0] view-ray density samples, [1] pixels marched.
-@group(1) @binding(4) var<storage, read_write> march_stats: array<atomic<u32>, 2>;
-@group(1) @binding(5) var cloud_depth_out: texture_storage_2d<r32float, write>;
-// Per-pixel sums over the samples of a multi-sample pass (MarchSum, declared with march_clouds).
-@group(1) @binding(6) var<storage, read_write> march_sums: array<MarchSum>;
+@group(3) @binding(1) var host_depth: texture_2d<f32>;
+@group(3) @binding(2) var cloud_out: texture_storage_2d<rgba16float, write>;
+// Counters over the frame: [0] view-ray density samples, [1] texels marched.
+@group(3) @binding(3) var<storage, read_write> march_stats: array<atomic<u32>, 2>;
+@group(3) @binding(4) var cloud_distance_out: texture_storage_2d<r32float, write>;
+@group(3) @binding(5) var<storage, read_write> march_sums: array<MarchSum>;
 
 // Rays stop once this little light gets through (VolumeCloud's threshold, peers.md).
 const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
@@ -41,12 +56,12 @@ const MARCH_SUN_PATH_MAX_M: f32 = 4000.0;
 // the layers (at most MARCH_SUN_PATH_MAX_M) (VolumeCloud samples the sun path at 0.5, 1.5, 3, 6, 12
 // units with weights 1, 1, 2, 4, 8; peers.md).
 fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
-    let sun = frame.sun_direction.xyz;
+    let sun = environment_sun_direction();
     var length_m = MARCH_SUN_PATH_MAX_M;
-    if field.counts.x > 0u {
-        length_m = clamp(field_below(p, sun, field.planet.w).y, 50.0, MARCH_SUN_PATH_MAX_M);
+    if field.layer_count > 0u {
+        length_m = clamp(field_below(p, sun, field.layer_top_m).y, 50.0, MARCH_SUN_PATH_MAX_M);
     }
-    return field_optical_depth_coarse(p, sun, vec3<f32>(0.0, length_m, 2.0), march.counts.y, jitter);
+    return field_optical_depth_coarse(p, sun, vec3<f32>(0.0, length_m, 2.0), march.light_steps, jitter);
 }
 
 // Light scattered from the sky above and the ground below, per unit sigma_s: each hemisphere
@@ -57,34 +72,34 @@ fn march_ambient(p: vec3<f32>, h: f32) -> vec3<f32> {
     let up = field_up(p);
     var above = 500.0;
     var below = 500.0;
-    if field.counts.x > 0u && h >= field.planet.z && h <= field.planet.w {
-        above = field.planet.w - h;
-        below = h - field.planet.z;
+    if field.layer_count > 0u && h >= field.layer_bottom_m && h <= field.layer_top_m {
+        above = field.layer_top_m - h;
+        below = h - field.layer_bottom_m;
     }
     let tau_up = field_extinction_coarse(p + up * (0.5 * above)) * above;
     let tau_down = field_extinction_coarse(p - up * (0.5 * below)) * below;
-    var ground = frame.ground_radiance.xyz;
-    if frame.ground_albedo.w < 0.5 {
-        ground = frame.sky_horizon.xyz;
+    var ground = environment_ground_radiance(frame.ground_albedo, p);
+    if frame.has_ground == 0u {
+        ground = environment.sky_horizon_radiance;
     }
-    let sky = frame.sky_mean_up.xyz;
-    return march.ambient.x * 0.5 * (sky * frame_diffuse_transmittance(frame, tau_up) + ground * frame_diffuse_transmittance(frame, tau_down));
+    let sky = environment_sky_mean_radiance_up(p);
+    return march.ambient_scale * 0.5 * (sky * frame_diffuse_transmittance(tau_up) + ground * frame_diffuse_transmittance(tau_down));
 }
 
-// Sun light scattered toward the eye per unit sigma_s, with multiple-scattering octaves
-// (Wrenninge 2013): sum_i b^i p(c^i g, mu) exp(-a^i tau_sun) E_sun.
-fn march_sun_scattering(cos_theta: f32, tau_sun: f32) -> vec3<f32> {
+// Sun light scattered toward the eye per unit sigma_s and unit sun irradiance, with
+// multiple-scattering octaves (Wrenninge 2013): sum_i b^i p(c^i g, mu) exp(-a^i tau_sun).
+fn march_sun_scattering(cos_theta: f32, tau_sun: f32) -> f32 {
     var sum = 0.0;
     var weight = 1.0;
     var extinction = 1.0;
     var anisotropy = 1.0;
-    for (var i = 0u; i < march.counts.w; i++) {
-        sum += weight * phase_eval(phase_scaled(march.phase, anisotropy), cos_theta) * exp(-extinction * tau_sun);
-        weight *= march.octaves.y;
-        extinction *= march.octaves.x;
-        anisotropy *= march.octaves.z;
+    for (var i = 0u; i < march.octaves; i++) {
+        sum += weight * phase_eval(phase_scaled(march.phase_lobes, anisotropy), cos_theta) * exp(-extinction * tau_sun);
+        weight *= march.octave_contribution;
+        extinction *= march.octave_attenuation;
+        anisotropy *= march.octave_eccentricity;
     }
-    return sum * frame.sun_irradiance.xyz;
+    return sum;
 }
 
 // Ray parameter of stratum boundary u in [0, 1]: quadratic spacing, so strata start short where
@@ -97,9 +112,9 @@ fn march_stratum_t(t0: f32, t1: f32, u: f32) -> f32 {
 // up to four times as many for the long grazing rays that cross the layer toward the horizon or
 // along it from inside.
 fn march_step_count(length_m: f32) -> u32 {
-    let band_m = max(field.planet.w - field.planet.z, 1.0);
+    let band_m = max(field.layer_top_m - field.layer_bottom_m, 1.0);
     let scale = clamp(length_m / (2.0 * band_m), 1.0, 4.0);
-    return u32(f32(march.counts.x) * scale);
+    return u32(f32(march.primary_steps) * scale);
 }
 
 // Where the leading stretch of [t0, t1] that the hi-height pyramid proves empty ends (t0 when
@@ -107,7 +122,7 @@ fn march_step_count(length_m: f32) -> u32 {
 // One query per ray, before the march: queries between samples would make the lanes of a SIMD
 // group wait on each other's traversals, and cost more than the empty samples they save.
 fn march_empty_until(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, volume: vec2<f32>) -> f32 {
-    if march.flags.x != 1u || field.counts.z == 0u {
+    if march.empty_space_skipping != 1u || field.hiheight_level_count == 0u {
         return t0;
     }
     return min(field_empty_until(o, d, t0, t1), max(volume.x, t0));
@@ -127,11 +142,11 @@ fn march_first_stratum(t0: f32, t1: f32, n: u32, empty_until: f32) -> u32 {
 // `volume` is the stretch inside voxel-grid boxes.
 fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volume: vec2<f32>) -> MarchResult {
     let n = march_step_count(t1 - t0);
-    let cos_theta = dot(d, frame.sun_direction.xyz);
-    let albedo = march.octaves.w;
+    let cos_theta = dot(d, environment_sun_direction());
+    let albedo = march.albedo;
     var radiance = vec3<f32>(0.0);
     var transmittance = 1.0;
-    var depth_weighted = 0.0;
+    var distance_weighted = 0.0;
     var samples = 0u;
     let empty_until = march_empty_until(o, d, t0, t1, volume);
     let first = march_first_stratum(t0, t1, n, empty_until);
@@ -152,19 +167,19 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
         }
         let h = field_altitude_m(p);
         let tau_sun = march_sun_optical_depth(p, jitter);
-        let source = albedo * (march_sun_scattering(cos_theta, tau_sun) + march_ambient(p, h));
+        let sun = march_sun_scattering(cos_theta, tau_sun) * environment_sun_irradiance(p);
+        let source = albedo * (sun + march_ambient(p, h));
         let step_transmittance = exp(-sigma_t * dt);
         radiance += transmittance * source * (1.0 - step_transmittance);
-        depth_weighted += transmittance * (1.0 - step_transmittance) * distance(p, o);
+        distance_weighted += transmittance * (1.0 - step_transmittance) * distance(p, o);
         transmittance *= step_transmittance;
         if transmittance < MARCH_MIN_TRANSMITTANCE {
             break;
         }
     }
-    // Aerial perspective at the transmittance-weighted mean cloud depth (Hillaire 2016, 5.9.1).
     let coverage = 1.0 - transmittance;
-    let depth = select(0.0, depth_weighted / coverage, coverage > 0.0);
-    return MarchResult(frame_haze(frame, radiance, coverage, depth), transmittance, samples, depth);
+    let distance_m = select(0.0, distance_weighted / coverage, coverage > 0.0);
+    return MarchResult(radiance, transmittance, samples, distance_m);
 }
 
 // The seed's 3x3 Bayer matrix (volumecloud-implementation-detail): per-pixel ray offsets in ninths.
@@ -174,35 +189,29 @@ const MARCH_BAYER_3X3 = array<f32, 9>(0.0, 7.0, 3.0, 6.0, 5.0, 2.0, 4.0, 1.0, 8.
 // reuse, the frame's Halton value plus the pixel's Bayer offset, fract(halton + bayer / 9), so that
 // each 3x3 neighbourhood spans the stratum (the seed's fix for AABB clipping of undersampled rays).
 fn march_ray_offset(px: vec2<u32>) -> f32 {
-    if march.grid.w == 0u {
-        return frame_pixel_jitter(px, u32(frame.viewport.w));
+    if frame.temporal_ray_offsets == 0u {
+        return frame_pixel_jitter(px, frame.frame_index);
     }
-    return fract(march.ray_offset.x + MARCH_BAYER_3X3[(px.x % 3u) * 3u + px.y % 3u] / 9.0);
+    return fract(frame.ray_offset_strata + MARCH_BAYER_3X3[(px.x % 3u) * 3u + px.y % 3u] / 9.0);
 }
 
 // The farthest host depth over a block of the full-resolution depth buffer: a low-resolution ray
 // must not stop short of geometry that only part of its block has (Yusov 2014).
 fn march_block_depth(block: vec2<u32>, size: u32) -> f32 {
-    var depth = 0.0;
-    let full = vec2<u32>(frame.viewport.xy);
+    var depth = 1.0 - frame.depth_far_value; // the nearest value: any geometry is farther
+    let full = vec2<u32>(frame.viewport_px);
     for (var y = 0u; y < size; y++) {
         for (var x = 0u; x < size; x++) {
             let texel = min(block * size + vec2<u32>(x, y), full - 1u);
-            depth = max(depth, textureLoad(host_depth, vec2<i32>(texel), 0).x);
+            depth = frame_farther_depth(depth, textureLoad(host_depth, vec2<i32>(texel), 0).x);
         }
     }
     return depth;
 }
 
-// Running sums of one pixel's samples while the pass is dispatched once per sample.
-struct MarchSum {
-    radiance_transmittance: vec4<f32>,
-    depth_m: f32,
-    samples: u32, // samples summed so far
-}
 
-// One sample of one ray per pixel of the march grid (1/divisor of the frame's resolution), through
-// the sub-pixel of its block this frame updates. With several samples per pixel the pass is
+// One sample of one ray per texel of the output grid (1/divisor of the frame's resolution), through
+// the sub-pixel of its block the frame's grid names. With several samples per pixel the pass is
 // dispatched once per sample and sums them in `march_sums`: llvmpipe caps the loop iterations of
 // one invocation at 65535 in total (LP_MAX_TGSI_LOOP_ITERATIONS, Mesa gallivm), which long grazing
 // rays times several samples exceed, and short invocations suit GPUs as well. The last sample writes
@@ -210,23 +219,22 @@ struct MarchSum {
 // cloud).
 @compute @workgroup_size(8, 8)
 fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
-    let px = id.xy + march.tile.xy;
-    let divisor = march.grid.x;
-    let grid = (vec2<u32>(frame.viewport.xy) + divisor - 1u) / divisor;
+    let px = id.xy + march.tile_origin;
+    let divisor = frame.grid_divisor;
+    let viewport = vec2<u32>(frame.viewport_px);
+    let grid = (viewport + divisor - 1u) / divisor;
     if px.x >= grid.x || px.y >= grid.y {
         return;
     }
-    let full_px = min(px * divisor + march.grid.yz, vec2<u32>(frame.viewport.xy) - 1u);
+    let full_px = min(px * divisor + frame.grid_subpixel, viewport - 1u);
     let pixel = vec2<f32>(full_px) + 0.5;
-    let o = frame.camera_position.xyz;
-    let d = frame_ray_direction(frame, pixel);
+    let o = frame.camera_position_m;
+    let d = frame_ray_direction(pixel);
     let depth = march_block_depth(px, divisor);
-    var t_max = min(frame.camera_position.w, field_ground_distance(o, d, frame.ground_albedo.w > 0.5));
-    if depth < 1.0 {
-        t_max = min(t_max, frame_depth_distance(frame, pixel, depth));
-    }
-    let spp = march.counts.z;
-    let slot = id.y * march.tile.z + id.x;
+    var t_max = min(frame.far_m, field_ground_distance(o, d, frame.has_ground == 1u));
+    t_max = min(t_max, frame_depth_distance(pixel, depth));
+    let spp = march.samples_per_pixel;
+    let slot = id.y * march.tile_width + id.x;
     var sample_index = 0u;
     if spp > 1u {
         sample_index = march_sums[slot].samples;
@@ -236,26 +244,26 @@ fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     let t0 = min(select(FIELD_NO_HIT, layer.x, layer.x < layer.y), volume.x);
     let t1 = max(select(-FIELD_NO_HIT, layer.y, layer.x < layer.y), volume.y);
     var result = vec4<f32>(0.0, 0.0, 0.0, 1.0);
-    var cloud_depth = 0.0;
+    var distance_m = 0.0;
     if t0 < t1 {
         // Samples of one pixel are stratified: offsets s / spp from the pixel's ray offset.
         let jitter = fract(march_ray_offset(px) + f32(sample_index) / f32(spp));
         let m = march_segment(o, d, t0, t1, jitter, volume);
         result = vec4<f32>(m.radiance, m.transmittance);
-        cloud_depth = m.depth_m;
+        distance_m = m.distance_m;
         atomicAdd(&march_stats[0], m.density_samples);
     }
     if spp > 1u {
         let sum = march_sums[slot];
         if sample_index + 1u < spp {
-            march_sums[slot] = MarchSum(sum.radiance_transmittance + result, sum.depth_m + cloud_depth, sample_index + 1u);
+            march_sums[slot] = MarchSum(sum.radiance_transmittance + result, sum.distance_m + distance_m, sample_index + 1u, vec2<u32>(0u));
             return;
         }
-        march_sums[slot] = MarchSum(vec4<f32>(0.0), 0.0, 0u); // ready for the next pass
+        march_sums[slot] = MarchSum(vec4<f32>(0.0), 0.0, 0u, vec2<u32>(0u)); // ready for the next pass
         result = (sum.radiance_transmittance + result) / f32(spp);
-        cloud_depth = (sum.depth_m + cloud_depth) / f32(spp);
+        distance_m = (sum.distance_m + distance_m) / f32(spp);
     }
     atomicAdd(&march_stats[1], 1u);
     textureStore(cloud_out, vec2<i32>(px), result);
-    textureStore(cloud_depth_out, vec2<i32>(px), vec4<f32>(cloud_depth, 0.0, 0.0, 0.0));
+    textureStore(cloud_distance_out, vec2<i32>(px), vec4<f32>(distance_m, 0.0, 0.0, 0.0));
 }

@@ -464,6 +464,24 @@ impl Default for Lighting {
 pub enum Technique {
     /// Ray-marched clouds (compute).
     Raymarch,
+    /// Volumetric particles with precomputed lighting (Yusov 2014); not built yet.
+    Particles,
+    /// Sprite-cluster clouds (Wang 2003); not built yet.
+    Sprites,
+}
+
+impl Technique {
+    /// The techniques this build can render (the renderer's dispatch builds each of them).
+    pub const BUILT: &[Technique] = &[Technique::Raymarch];
+
+    /// The name scene files use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Technique::Raymarch => "raymarch",
+            Technique::Particles => "particles",
+            Technique::Sprites => "sprites",
+        }
+    }
 }
 
 /// Named sets of step counts, from fast to converged.

@@ -5,7 +5,9 @@
 
 use std::fmt;
 
-use super::model::{CameraKey, CloudLayer, CoverageKey, Scene, SunKey, VolumeGrid, WeatherSource};
+use super::model::{
+    CameraKey, CloudLayer, CoverageKey, Scene, SunKey, Technique, VolumeGrid, WeatherSource,
+};
 
 /// A value that breaks a rule, by dotted key path.
 #[derive(Debug)]
@@ -309,6 +311,7 @@ const SCENE_RELATIONS: &[Relation<Scene>] = &[
     Relation { key: "camera.look_at_m", broken: look_at_is_the_eye },
     Relation { key: "weather.source", broken: weather_file_without_path },
     Relation { key: "render.output", broken: output_not_png_or_exr },
+    Relation { key: "render.technique", broken: technique_not_built },
 ];
 
 #[rustfmt::skip]
@@ -320,6 +323,18 @@ const LAYER_RELATIONS: &[Relation<CloudLayer>] = &[
 const VOLUME_RELATIONS: &[Relation<VolumeGrid>] = &[
     Relation { key: "path", broken: volume_without_path },
 ];
+
+fn technique_not_built(scene: &Scene) -> Option<String> {
+    let technique = scene.render.technique;
+    (!Technique::BUILT.contains(&technique)).then(|| {
+        let built: Vec<&str> = Technique::BUILT.iter().map(|t| t.name()).collect();
+        format!(
+            "{:?} is not built yet; built: {}",
+            technique.name(),
+            built.join(", ")
+        )
+    })
+}
 
 fn far_not_beyond_near(scene: &Scene) -> Option<String> {
     let (near, far) = (scene.camera.near_m, scene.camera.far_m);

@@ -237,8 +237,12 @@ impl<'a> Measurer<'a> {
             let mut s = still.clone();
             s.render.empty_space_skipping = skipping;
             let (ms, image) = self.timed(&s, frame, Reuse::None);
-            let stats = self.renderer.march_stats(self.ctx);
-            (ms, image, stats.density_samples_per_pixel)
+            let stats = self.renderer.stats(self.ctx);
+            (
+                ms,
+                image,
+                stats.map_or(0.0, |s| s.density_samples_per_pixel),
+            )
         };
         let (ms_off, off, samples_off) = run(false);
         let (ms_on, on, samples_on) = run(true);

@@ -1,0 +1,90 @@
+//! The frame on the GPU: one uniform in a bind group of its own, rewritten each frame.
+
+use super::Frame;
+use crate::gpu::uniform::UniformGroup;
+use crate::output::SampleGrid;
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, UVec2, Vec2, Vec3};
+
+/// GPU layout of a [`Frame`]: the `Frame` struct of `frame.wgsl`, member for member.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameUniform {
+    world_from_clip: Mat4,
+    clip_from_world: Mat4,
+    camera_position_m: Vec3,
+    far_m: f32,
+    ground_albedo: Vec3,
+    has_ground: u32,
+    viewport_px: Vec2,
+    time_s: f32,
+    frame_index: u32,
+    grid_subpixel: UVec2,
+    grid_divisor: u32,
+    ray_offset_strata: f32,
+    depth_far_value: f32,
+    depth_reversed: u32,
+    cloud_mean_cosine: f32,
+    temporal_ray_offsets: u32,
+}
+
+impl FrameUniform {
+    /// The uniform of `frame` with a technique output sampled on `grid`.
+    pub fn new(frame: &Frame, grid: &SampleGrid) -> FrameUniform {
+        let clip_from_world = frame.clip_from_world();
+        FrameUniform {
+            world_from_clip: clip_from_world.inverse(),
+            clip_from_world,
+            camera_position_m: frame.camera_position_m,
+            far_m: frame.far_m,
+            ground_albedo: frame.ground_albedo.unwrap_or(Vec3::ZERO),
+            has_ground: frame.ground_albedo.is_some() as u32,
+            viewport_px: frame.size.as_vec2(),
+            time_s: frame.time_s,
+            frame_index: frame.frame_index,
+            grid_subpixel: grid.subpixel,
+            grid_divisor: grid.divisor,
+            ray_offset_strata: grid.temporal_offset.unwrap_or(0.0),
+            depth_far_value: frame.depth.far_value(),
+            depth_reversed: frame.depth.is_reversed() as u32,
+            cloud_mean_cosine: frame.cloud_mean_cosine,
+            temporal_ray_offsets: grid.temporal_offset.is_some() as u32,
+        }
+    }
+}
+
+/// The frame's uniform buffer and bind group ([`crate::shader::FRAME_GROUP`] in every program):
+/// `FrameGpu::new(ctx, "frame")`, then `write(ctx, &frame.uniform(&grid))` once per frame.
+pub type FrameGpu = UniformGroup<FrameUniform>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout_check::assert_wgsl_layout;
+
+    #[test]
+    fn frame_uniform_matches_its_wgsl_layout() {
+        assert_wgsl_layout!(
+            "probe",
+            "Frame",
+            FrameUniform {
+                world_from_clip,
+                clip_from_world,
+                camera_position_m,
+                far_m,
+                ground_albedo,
+                has_ground,
+                viewport_px,
+                time_s,
+                frame_index,
+                grid_subpixel,
+                grid_divisor,
+                ray_offset_strata,
+                depth_far_value,
+                depth_reversed,
+                cloud_mean_cosine,
+                temporal_ray_offsets,
+            }
+        );
+    }
+}

@@ -1,0 +1,130 @@
+//! GPU probes: every WGSL function with a CPU twin, evaluated at given inputs, so tests hold the
+//! GPU against the CPU specification.
+
+use crate::frame::Shared;
+use crate::gpu::pipeline::{
+    UNIFORM, bind_group, bind_group_layout, compute_pipeline, storage_binding, storage_buffer,
+};
+use crate::gpu::{GpuContext, readback};
+use bytemuck::{Pod, Zeroable};
+use glam::Vec4;
+use wgpu::util::DeviceExt;
+
+/// A WGSL function and the inputs it reads from a probe's two vec4s `a` and `b`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum ProbeFunction {
+    /// `field_extinction(a.xyz)`: `CloudField::extinction_per_m`.
+    Extinction = 0,
+    /// `field_extinction_coarse(a.xyz)`: `CloudField::coarse_extinction_per_m`.
+    CoarseExtinction = 1,
+    /// `field_optical_depth_coarse(a.xyz, b.xyz, span (0, a.w, growth b.w), 16 segments, jitter
+    /// 0.5)`: the coarse light paths of the march and the ground shadows.
+    CoarseOpticalDepth = 2,
+    /// `frame_ray_direction(a.xy)`: `Frame::camera_ray`.
+    CameraRay = 3,
+    /// `frame_depth_distance(a.xy, depth a.z)`: `Frame::depth_distance_m` (1e30 for none).
+    DepthDistance = 4,
+    /// `environment_aerial_perspective(a.xyz, coverage a.w, distance b.x)`:
+    /// `Environment::aerial_perspective`.
+    AerialPerspective = 5,
+    /// `environment_sun_disc_radiance(a.xyz)`: `SunDisc::radiance`.
+    SunDiscRadiance = 6,
+    /// `environment_sky_radiance(a.xyz)`: `SkyRadiance::radiance`.
+    SkyRadiance = 7,
+    /// `environment_ground_radiance(albedo a.xyz, b.xyz)`: `Environment::ground_radiance`.
+    GroundRadiance = 8,
+    /// `tonemap_aces(a.xyz)`: `tonemap::aces`.
+    ToneMapAces = 9,
+    /// `tonemap_agx(a.xyz)`: `tonemap::agx`.
+    ToneMapAgx = 10,
+    /// `linear_to_srgb(a.xyz)`: `tonemap::linear_to_srgb`.
+    LinearToSrgb = 11,
+    /// `frame_diffuse_transmittance(a.x)`.
+    DiffuseTransmittance = 12,
+}
+
+/// The inputs of one evaluation.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct ProbeInput {
+    /// First argument vector.
+    pub a: Vec4,
+    /// Second argument vector.
+    pub b: Vec4,
+}
+
+/// The probe pipeline, built against the shared groups.
+pub struct Probe {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl Probe {
+    /// Builds the pipeline.
+    pub fn new(ctx: &GpuContext, shared: &Shared) -> Probe {
+        let layout = bind_group_layout(
+            &ctx.device,
+            "probe",
+            &[UNIFORM, storage_binding(true), storage_binding(false)],
+        );
+        let pipeline = compute_pipeline(
+            ctx,
+            "probe",
+            &crate::shader::program("probe"),
+            "probe_functions",
+            &shared.layouts(&layout),
+        );
+        Probe { pipeline, layout }
+    }
+
+    /// `function` at every input, as the GPU computes it with the shared groups' current contents
+    /// (waits for the result).
+    pub fn run(
+        &self,
+        ctx: &GpuContext,
+        shared: &Shared,
+        function: ProbeFunction,
+        inputs: &[ProbeInput],
+    ) -> Vec<Vec4> {
+        let device = &ctx.device;
+        let init = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let uniform = init(
+            "probe function",
+            bytemuck::bytes_of(&[function as u32, 0, 0, 0]),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let input = init(
+            "probe inputs",
+            bytemuck::cast_slice(inputs),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let output = storage_buffer(ctx, "probe outputs", (inputs.len().max(1) * 16) as u64);
+        let group = bind_group(
+            device,
+            &self.layout,
+            &[
+                uniform.as_entire_binding(),
+                input.as_entire_binding(),
+                output.as_entire_binding(),
+            ],
+        );
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.pipeline);
+            for (slot, g) in shared.bind_groups(&group).iter().enumerate() {
+                pass.set_bind_group(slot as u32, *g, &[]);
+            }
+            pass.dispatch_workgroups(inputs.len().div_ceil(64) as u32, 1, 1);
+        }
+        ctx.queue.submit([encoder.finish()]);
+        readback::read_buffer::<Vec4>(ctx, &output)
+    }
+}

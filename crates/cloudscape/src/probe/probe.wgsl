@@ -1,0 +1,44 @@
+#import hiheight frame environment tonemap
+// Evaluates one WGSL function that has a CPU twin at given inputs, so tests can hold the GPU
+// against the specification (probe/mod.rs lists the functions and their twins).
+
+struct ProbeInput {
+    a: vec4<f32>,
+    b: vec4<f32>,
+}
+
+struct Probe {
+    function: u32,
+}
+
+@group(3) @binding(0) var<uniform> probe: Probe;
+@group(3) @binding(1) var<storage, read> probe_inputs: array<ProbeInput>;
+@group(3) @binding(2) var<storage, read_write> probe_outputs: array<vec4<f32>>;
+
+fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
+    switch f {
+        case 0u: { return vec4<f32>(field_extinction(a.xyz)); }
+        case 1u: { return vec4<f32>(field_extinction_coarse(a.xyz)); }
+        case 2u: { return vec4<f32>(field_optical_depth_coarse(a.xyz, b.xyz, vec3<f32>(0.0, a.w, b.w), 16u, 0.5)); }
+        case 3u: { return vec4<f32>(frame_ray_direction(a.xy), 0.0); }
+        case 4u: { return vec4<f32>(min(frame_depth_distance(a.xy, a.z), 1.0e30)); }
+        case 5u: { return vec4<f32>(environment_aerial_perspective(a.xyz, a.w, b.x), 0.0); }
+        case 6u: { return vec4<f32>(environment_sun_disc_radiance(a.xyz), 0.0); }
+        case 7u: { return vec4<f32>(environment_sky_radiance(a.xyz), 0.0); }
+        case 8u: { return vec4<f32>(environment_ground_radiance(a.xyz, b.xyz), 0.0); }
+        case 9u: { return vec4<f32>(tonemap_aces(a.xyz), 0.0); }
+        case 10u: { return vec4<f32>(tonemap_agx(a.xyz), 0.0); }
+        case 11u: { return vec4<f32>(linear_to_srgb(a.xyz), 0.0); }
+        case 12u: { return vec4<f32>(frame_diffuse_transmittance(a.x)); }
+        default: { return vec4<f32>(-1.0); }
+    }
+}
+
+@compute @workgroup_size(64)
+fn probe_functions(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= arrayLength(&probe_inputs) {
+        return;
+    }
+    let input = probe_inputs[id.x];
+    probe_outputs[id.x] = probe_eval(probe.function, input.a, input.b);
+}

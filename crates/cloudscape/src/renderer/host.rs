@@ -1,0 +1,310 @@
+//! [`CloudRenderer`]: one frame, any technique, on the host's device, depth buffer and scene colour.
+//!
+//! Per frame: [`CloudRenderer::begin_frame`] uploads the frame, environment, field time and the
+//! technique's settings; [`CloudRenderer::encode_clouds`] records the technique into the cloud
+//! output; [`CloudRenderer::encode_finish`] records temporal reuse (when asked for), composition
+//! over the host's colour (or the sky, sun and ground) and tone mapping. Nothing waits on the GPU;
+//! statistics come back a frame late ([`CloudRenderer::stats`]).
+
+use super::dispatch;
+use crate::environment::{Environment, EnvironmentGpu, EnvironmentUniform};
+use crate::field::gpu::{FieldGpu, FieldUpdate};
+use crate::field::{CloudField, FieldError};
+use crate::frame::{Frame, FrameGpu, Shared};
+use crate::gpu::pipeline::{STORAGE_OUTPUT, texture_2d};
+use crate::gpu::{GpuContext, PassTimer};
+use crate::output::{CloudOutput, SampleGrid};
+use crate::post::{Background, Compositor, DISPLAY_FORMAT, Display, HDR_FORMAT};
+use crate::scene::Scene;
+use crate::technique::{Technique, TechniqueStats, TechniqueTargets};
+use crate::temporal::{TemporalResolve, TemporalSettings};
+use glam::{UVec2, Vec2};
+use std::path::Path;
+
+/// Whether a frame reuses earlier frames.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Reuse {
+    /// Every pixel rendered afresh.
+    None,
+    /// A coarse grid per frame plus reprojected history.
+    Temporal(TemporalSettings),
+}
+
+/// The images of the last frame, on the GPU: the host samples or presents them.
+pub struct FrameImages<'a> {
+    /// Full-resolution cloud output (after temporal reuse, when on).
+    pub clouds: &'a CloudOutput,
+    /// Composed linear radiance, [`HDR_FORMAT`].
+    pub hdr: &'a wgpu::Texture,
+    /// Exposed, tone-mapped, sRGB-encoded, [`DISPLAY_FORMAT`].
+    pub ldr: &'a wgpu::Texture,
+}
+
+/// The targets of one frame size.
+struct Targets {
+    size: UVec2,
+    grid: SampleGrid,
+    output: CloudOutput,
+    hdr: wgpu::Texture,
+    hdr_view: wgpu::TextureView,
+    ldr: wgpu::Texture,
+    ldr_view: wgpu::TextureView,
+}
+
+impl Targets {
+    fn new(ctx: &GpuContext, size: UVec2, grid: SampleGrid) -> Targets {
+        let hdr = texture_2d(ctx, "hdr", size, HDR_FORMAT, STORAGE_OUTPUT);
+        let ldr = texture_2d(ctx, "ldr", size, DISPLAY_FORMAT, STORAGE_OUTPUT);
+        Targets {
+            size,
+            grid,
+            output: CloudOutput::new(ctx, "cloud output", grid.size(size)),
+            hdr_view: hdr.create_view(&Default::default()),
+            ldr_view: ldr.create_view(&Default::default()),
+            hdr,
+            ldr,
+        }
+    }
+}
+
+/// Clouds for a host renderer: the field, the shared frame state, the scene's technique and the
+/// shared passes, made once.
+pub struct CloudRenderer {
+    field: CloudField,
+    field_gpu: FieldGpu,
+    frame_gpu: FrameGpu,
+    environment_gpu: EnvironmentGpu,
+    technique: Box<dyn Technique>,
+    temporal: Option<TemporalResolve>,
+    compositor: Compositor,
+    display: Display,
+    targets: Option<Targets>,
+    frame: Option<Frame>,
+    reuse: Reuse,
+}
+
+impl CloudRenderer {
+    /// Builds the field of `scene` (files resolve against `base_dir`), the technique it names and
+    /// every pass.
+    pub fn new(
+        ctx: &GpuContext,
+        scene: &Scene,
+        base_dir: &Path,
+    ) -> Result<CloudRenderer, FieldError> {
+        let field = CloudField::new(scene, base_dir)?;
+        let field_gpu = FieldGpu::new(ctx, &field);
+        let frame_gpu = FrameGpu::new(ctx, "frame");
+        let environment_gpu = EnvironmentGpu::new(ctx, "environment");
+        let shared = Shared {
+            field: &field_gpu,
+            frame: &frame_gpu,
+            environment: &environment_gpu,
+        };
+        let technique = dispatch::build(ctx, &shared, scene.render.technique)?;
+        let compositor = Compositor::new(ctx, &shared);
+        Ok(CloudRenderer {
+            field,
+            field_gpu,
+            frame_gpu,
+            environment_gpu,
+            technique,
+            temporal: None,
+            compositor,
+            display: Display::new(ctx),
+            targets: None,
+            frame: None,
+            reuse: Reuse::None,
+        })
+    }
+
+    /// Takes a live edit of `scene`: a new cloud field (coverage, wind, types, weather, grids) is
+    /// uploaded without regenerating the noise unless its seed changed, and a new technique is
+    /// built only when `render.technique` changed. Lighting, sun and sky need no call: every
+    /// [`CloudRenderer::begin_frame`] reads them.
+    pub fn update_scene(
+        &mut self,
+        ctx: &GpuContext,
+        scene: &Scene,
+        base_dir: &Path,
+    ) -> Result<FieldUpdate, FieldError> {
+        self.field = CloudField::new(scene, base_dir)?;
+        let update = self.field_gpu.update(ctx, &self.field);
+        if self.technique.name() != scene.render.technique.name() {
+            self.technique = dispatch::build(ctx, &self.shared(), scene.render.technique)?;
+        }
+        self.reset_history();
+        Ok(update)
+    }
+
+    /// The CPU field drawn (the specification the GPU follows).
+    pub fn field(&self) -> &CloudField {
+        &self.field
+    }
+
+    /// The field's GPU resources.
+    pub fn field_gpu(&self) -> &FieldGpu {
+        &self.field_gpu
+    }
+
+    /// The shared groups, for passes a host adds (probes, its own effects).
+    pub fn shared(&self) -> Shared<'_> {
+        Shared {
+            field: &self.field_gpu,
+            frame: &self.frame_gpu,
+            environment: &self.environment_gpu,
+        }
+    }
+
+    /// The technique in use.
+    pub fn technique_name(&self) -> &'static str {
+        self.technique.name()
+    }
+
+    /// Starts a frame: uploads `frame`, the scene's environment, the field's time and the
+    /// technique's settings, and picks this frame's sample grid. `frame.frame_index` must advance
+    /// every frame when `reuse` is temporal.
+    pub fn begin_frame(&mut self, ctx: &GpuContext, scene: &Scene, frame: &Frame, reuse: Reuse) {
+        if let Reuse::Temporal(settings) = reuse {
+            if self
+                .temporal
+                .as_ref()
+                .is_none_or(|t| *t.settings() != settings)
+            {
+                self.temporal = Some(TemporalResolve::new(ctx, &self.shared(), settings));
+            }
+        }
+        let grid = match (reuse, &self.temporal) {
+            (Reuse::Temporal(_), Some(t)) => t.grid(frame.frame_index),
+            _ => SampleGrid::FULL,
+        };
+        let (size, divisor) = (frame.size, grid.divisor);
+        if self
+            .targets
+            .as_ref()
+            .is_none_or(|t| t.size != size || t.grid.divisor != divisor)
+        {
+            self.targets = Some(Targets::new(ctx, size, grid));
+        }
+        self.targets.as_mut().expect("targets were just made").grid = grid;
+        self.field_gpu.set_time(ctx, &self.field, frame.time_s);
+        self.frame_gpu.write(ctx, &frame.uniform(&grid));
+        let environment = EnvironmentUniform::new(&Environment::from_scene(scene));
+        self.environment_gpu.write(ctx, &environment);
+        self.technique.prepare(ctx, scene);
+        self.frame = Some(frame.clone());
+        self.reuse = reuse;
+    }
+
+    /// The size of this frame's cloud output (the technique's grid), in texels.
+    pub fn output_size(&self) -> UVec2 {
+        self.targets().output.size
+    }
+
+    fn targets(&self) -> &Targets {
+        self.targets
+            .as_ref()
+            .expect("begin_frame makes the targets")
+    }
+
+    /// Records the technique over output texels `region` (origin, size; None for all of them).
+    pub fn encode_clouds(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        host_depth: &wgpu::TextureView,
+        region: Option<(UVec2, UVec2)>,
+        timer: Option<&mut PassTimer>,
+    ) {
+        let shared = Shared {
+            field: &self.field_gpu,
+            frame: &self.frame_gpu,
+            environment: &self.environment_gpu,
+        };
+        let t = self
+            .targets
+            .as_ref()
+            .expect("begin_frame makes the targets");
+        let region = region.unwrap_or((UVec2::ZERO, t.output.size));
+        let targets = TechniqueTargets {
+            host_depth,
+            output: &t.output,
+        };
+        let timer = timer.map(|t| (t, "technique"));
+        self.technique
+            .encode(ctx, encoder, &shared, &targets, region, timer);
+    }
+
+    /// Records the rest of the frame: temporal reuse, composition over `background` with aerial
+    /// perspective, and tone mapping with the scene's exposure and operator.
+    pub fn encode_finish(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &Scene,
+        background: &Background,
+        mut timer: Option<&mut PassTimer>,
+    ) {
+        self.technique.finish_frame(encoder);
+        let shared = Shared {
+            field: &self.field_gpu,
+            frame: &self.frame_gpu,
+            environment: &self.environment_gpu,
+        };
+        let frame = self.frame.as_ref().expect("begin_frame stores the frame");
+        let t = self
+            .targets
+            .as_ref()
+            .expect("begin_frame makes the targets");
+        let clouds = match (self.reuse, self.temporal.as_mut()) {
+            (Reuse::Temporal(_), Some(temporal)) => {
+                let wind = self
+                    .field
+                    .layers
+                    .first()
+                    .map_or(Vec2::ZERO, |l| l.wind_m_per_s);
+                let inputs = (&t.output, background.depth);
+                let timer = timer.as_deref_mut();
+                temporal.encode(ctx, encoder, &shared, (frame, wind), inputs, timer)
+            }
+            _ => &t.output,
+        };
+        let timed = timer.as_deref_mut();
+        self.compositor.encode(
+            ctx,
+            encoder,
+            &shared,
+            (clouds, background),
+            &t.hdr_view,
+            timed,
+        );
+        let display = (scene.render.exposure_ev, scene.render.tonemap);
+        let views = (&t.hdr_view, &t.ldr_view, t.size);
+        self.display.encode(ctx, encoder, views, display, timer);
+    }
+
+    /// The images of the last frame encoded, valid once its work is submitted.
+    pub fn images(&self) -> FrameImages<'_> {
+        let t = self.targets();
+        let clouds = match (self.reuse, &self.temporal) {
+            (Reuse::Temporal(_), Some(temporal)) => temporal.latest().unwrap_or(&t.output),
+            _ => &t.output,
+        };
+        FrameImages {
+            clouds,
+            hdr: &t.hdr,
+            ldr: &t.ldr,
+        }
+    }
+
+    /// What the technique counted in the newest frame the GPU has finished (never waits).
+    pub fn stats(&mut self, ctx: &GpuContext) -> Option<TechniqueStats> {
+        self.technique.stats(ctx)
+    }
+
+    /// Forgets the temporal history (a camera cut; new weather).
+    pub fn reset_history(&mut self) {
+        if let Some(t) = self.temporal.as_mut() {
+            t.reset();
+        }
+    }
+}

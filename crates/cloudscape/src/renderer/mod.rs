@@ -1,0 +1,203 @@
+//! Renderers: [`CloudRenderer`], the clouds on a host's device, depth buffer and scene colour
+//! (what a game engine uses), and [`SceneRenderer`], the offline host that the CLI, tests and
+//! benchmarks use: a whole scene to an image over the built-in sky, sun and ground.
+
+mod dispatch;
+mod host;
+
+pub use host::{CloudRenderer, FrameImages, Reuse};
+
+use crate::field::{CloudField, FieldError};
+use crate::frame::Frame;
+use crate::gpu::pipeline::texture_2d;
+use crate::gpu::{GpuContext, PassTimer, readback};
+use crate::image::{HdrImage, LdrImage};
+use crate::post::{Background, HDR_FORMAT};
+use crate::scene::Scene;
+use crate::technique::TechniqueStats;
+use glam::UVec2;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+/// Rows of output texels rendered per submission when reporting progress.
+const TILE_ROWS: u32 = 32;
+
+/// Names of the GPU passes of one frame, in order, as [`PassTimer`] labels them.
+pub const PASSES: [&str; 4] = ["technique", "temporal resolve", "compose", "display"];
+
+/// The images of one render.
+pub struct Rendered {
+    /// Linear HDR radiance.
+    pub hdr: HdrImage,
+    /// Exposed, tone-mapped, sRGB-encoded.
+    pub ldr: LdrImage,
+}
+
+/// An offline host's empty scene: a depth buffer with no geometry and a colour never shown.
+struct EmptyHost {
+    size: UVec2,
+    depth: wgpu::TextureView,
+    color: wgpu::TextureView,
+}
+
+impl EmptyHost {
+    fn new(ctx: &GpuContext, size: UVec2, frame: &Frame) -> EmptyHost {
+        use wgpu::TextureUsages as U;
+        let usage = U::TEXTURE_BINDING | U::RENDER_ATTACHMENT;
+        let depth = texture_2d(ctx, "depth", size, wgpu::TextureFormat::Depth32Float, usage)
+            .create_view(&Default::default());
+        let color = texture_2d(ctx, "host colour", size, HDR_FORMAT, U::TEXTURE_BINDING)
+            .create_view(&Default::default());
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("clear depth"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(frame.depth.far_value()),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        ctx.queue.submit([encoder.finish()]);
+        EmptyHost { size, depth, color }
+    }
+
+    fn background(&self) -> Background<'_> {
+        Background {
+            color: &self.color,
+            depth: &self.depth,
+        }
+    }
+}
+
+/// Renders scenes with the technique they name over the built-in sky, sun and ground, and reads the
+/// images back: an offline host of [`CloudRenderer`] that waits for the GPU to time its frames.
+pub struct SceneRenderer {
+    clouds: CloudRenderer,
+    host: Option<EmptyHost>,
+}
+
+impl SceneRenderer {
+    /// Builds the field of `scene` (files resolve against `base_dir`) and every pass.
+    pub fn new(
+        ctx: &GpuContext,
+        scene: &Scene,
+        base_dir: &Path,
+    ) -> Result<SceneRenderer, FieldError> {
+        Ok(SceneRenderer {
+            clouds: CloudRenderer::new(ctx, scene, base_dir)?,
+            host: None,
+        })
+    }
+
+    /// The CPU field this renderer draws (the specification the GPU follows).
+    pub fn field(&self) -> &CloudField {
+        self.clouds.field()
+    }
+
+    /// The renderer a real-time host would drive.
+    pub fn clouds(&mut self) -> &mut CloudRenderer {
+        &mut self.clouds
+    }
+
+    /// What the technique counted during the last render (waits for it).
+    pub fn stats(&mut self, ctx: &GpuContext) -> Option<TechniqueStats> {
+        ctx.wait_idle();
+        self.clouds.stats(ctx)
+    }
+
+    fn host(&mut self, ctx: &GpuContext, frame: &Frame) -> &EmptyHost {
+        if self.host.as_ref().is_none_or(|h| h.size != frame.size) {
+            self.host = Some(EmptyHost::new(ctx, frame.size, frame));
+        }
+        self.host.as_ref().expect("the host was just made")
+    }
+
+    /// Renders `scene` as it describes itself (size, steps, exposure), calling `progress` with the
+    /// fraction done after each band of rows.
+    pub fn render(
+        &mut self,
+        ctx: &GpuContext,
+        scene: &Scene,
+        mut progress: impl FnMut(f32),
+    ) -> Rendered {
+        let size = UVec2::new(scene.render.width, scene.render.height);
+        let frame = Frame::from_scene(scene, size);
+        self.host(ctx, &frame);
+        let host = self.host.as_ref().expect("made above");
+        self.clouds.begin_frame(ctx, scene, &frame, Reuse::None);
+        for row in (0..size.y).step_by(TILE_ROWS as usize) {
+            let band = (
+                UVec2::new(0, row),
+                UVec2::new(size.x, TILE_ROWS.min(size.y - row)),
+            );
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            self.clouds
+                .encode_clouds(ctx, &mut encoder, &host.depth, Some(band), None);
+            ctx.queue.submit([encoder.finish()]);
+            ctx.wait_idle();
+            progress((row + band.1.y) as f32 / size.y as f32);
+        }
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.clouds
+            .encode_finish(ctx, &mut encoder, scene, &host.background(), None);
+        ctx.queue.submit([encoder.finish()]);
+        self.images(ctx)
+    }
+
+    /// Renders one whole frame in a single submission and returns its wall time (it waits for the
+    /// GPU), with per-pass GPU times in `timer` when the adapter has timestamp queries: the unit of
+    /// `cloudscape bench` and of sequences. With [`Reuse::Temporal`] the technique renders a coarse
+    /// grid and a history carried from frame to frame fills in the rest. Read the images with
+    /// [`SceneRenderer::images`].
+    pub fn render_frame(
+        &mut self,
+        ctx: &GpuContext,
+        scene: &Scene,
+        frame: &Frame,
+        reuse: Reuse,
+        timer: &mut PassTimer,
+    ) -> Duration {
+        let start = Instant::now();
+        timer.reset();
+        self.host(ctx, frame);
+        let host = self.host.as_ref().expect("made above");
+        self.clouds.begin_frame(ctx, scene, frame, reuse);
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.clouds
+            .encode_clouds(ctx, &mut encoder, &host.depth, None, Some(timer));
+        self.clouds
+            .encode_finish(ctx, &mut encoder, scene, &host.background(), Some(timer));
+        timer.resolve(&mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+        ctx.wait_idle();
+        start.elapsed()
+    }
+
+    /// Forgets the temporal history (a camera cut; new weather).
+    pub fn reset_history(&mut self) {
+        self.clouds.reset_history();
+    }
+
+    /// The images of the last frame rendered (waits for it).
+    pub fn images(&self, ctx: &GpuContext) -> Rendered {
+        let images = self.clouds.images();
+        let (width, height) = (images.hdr.width(), images.hdr.height());
+        let hdr = HdrImage {
+            width,
+            height,
+            pixels: readback::read_texture_rgba16f(ctx, images.hdr),
+        };
+        let bytes = readback::read_texture(ctx, images.ldr);
+        let ldr = LdrImage {
+            width,
+            height,
+            pixels: bytemuck::cast_slice(&bytes).to_vec(),
+        };
+        Rendered { hdr, ldr }
+    }
+}

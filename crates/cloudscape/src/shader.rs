@@ -1,0 +1,197 @@
+//! WGSL programs assembled from modules that import what they use.
+//!
+//! Each `.wgsl` file of the crate is a module named in [`MODULES`]. A module's first lines may be
+//! `#import a b ...`: the modules it uses. [`program`] starts from a root module (one with an entry
+//! point), puts every module it reaches once, each after everything it imports, and drops the
+//! `#import` lines, so the result is plain WGSL that naga and every wgpu backend accept. The
+//! `constants` module is generated from the Rust constants it mirrors ([`constants_wgsl`]), so a
+//! value shared by both sides is written once.
+//!
+//! A registry rather than naga_oil: the modules already prefix their names (`field_`, `frame_`,
+//! `march_`), so no name mangling is needed, and the programs stay WGSL text that the shader
+//! tests parse with naga and that wgpu's GL backend translates like any other.
+
+use std::collections::HashSet;
+use std::fmt::Write;
+
+/// One WGSL module: its name in `#import` lines and its source.
+#[derive(Clone, Copy, Debug)]
+pub struct WgslModule {
+    /// The name other modules import it by.
+    pub name: &'static str,
+    /// The WGSL text, `#import` lines included.
+    pub source: &'static str,
+}
+
+const fn module(name: &'static str, source: &'static str) -> WgslModule {
+    WgslModule { name, source }
+}
+
+/// Every WGSL module of the crate but the generated `constants`.
+pub const MODULES: &[WgslModule] = &[
+    module("noise", include_str!("field/noise.wgsl")),
+    module("noise_gen", include_str!("field/noise_gen.wgsl")),
+    module("field", include_str!("field/field.wgsl")),
+    module("hiheight", include_str!("field/hiheight.wgsl")),
+    module("phase", include_str!("optics/phase.wgsl")),
+    module("frame", include_str!("frame/frame.wgsl")),
+    module("environment", include_str!("environment/environment.wgsl")),
+    module("raymarch", include_str!("raymarch/raymarch.wgsl")),
+    module("upsample", include_str!("temporal/upsample.wgsl")),
+    module("temporal", include_str!("temporal/temporal.wgsl")),
+    module("compose", include_str!("post/compose.wgsl")),
+    module("tonemap", include_str!("post/tonemap.wgsl")),
+    module("display", include_str!("post/display.wgsl")),
+    module("probe", include_str!("probe/probe.wgsl")),
+];
+
+/// The modules with entry points: every pipeline the crate builds starts from one of these.
+pub const PROGRAMS: &[&str] = &[
+    "noise_gen",
+    "raymarch",
+    "temporal",
+    "compose",
+    "display",
+    "probe",
+];
+
+/// Bind group slots shared by every program: the field, the frame, the environment; each pass
+/// binds its own resources at [`PASS_GROUP`].
+pub const FIELD_GROUP: u32 = 0;
+/// Slot of [`crate::frame::FrameGpu`]'s bind group.
+pub const FRAME_GROUP: u32 = 1;
+/// Slot of [`crate::environment::EnvironmentGpu`]'s bind group.
+pub const ENVIRONMENT_GROUP: u32 = 2;
+/// Slot of a pass's own bind group.
+pub const PASS_GROUP: u32 = 3;
+
+/// The WGSL of the Rust constants the shaders share, one `const` each.
+pub fn constants_wgsl() -> String {
+    use crate::field::{
+        GOLDEN_RATIO_CONJUGATE, MAX_LAYERS, MAX_VOLUMES, gpu::MAX_HIHEIGHT_LEVELS, profile,
+    };
+    let mut s = String::from("// Generated from Rust by shader::constants_wgsl: edit the Rust.\n");
+    let mut put = |line: String| writeln!(s, "{line}").expect("writing to a String");
+    put(format!("const PI: f32 = {:?};", std::f32::consts::PI));
+    put(format!("const MAX_LAYERS: u32 = {MAX_LAYERS}u;"));
+    put(format!(
+        "const GOLDEN_RATIO_CONJUGATE: f32 = {GOLDEN_RATIO_CONJUGATE:?};"
+    ));
+    put(format!("const MAX_VOLUMES: u32 = {MAX_VOLUMES}u;"));
+    put(format!(
+        "const MAX_HIHEIGHT_LEVELS: u32 = {MAX_HIHEIGHT_LEVELS}u;"
+    ));
+    let gradients: Vec<String> = profile::TYPE_GRADIENTS
+        .iter()
+        .map(|g| format!("vec4<f32>({:?}, {:?}, {:?}, {:?})", g[0], g[1], g[2], g[3]))
+        .collect();
+    put(format!(
+        "const TYPE_GRADIENTS = array<vec4<f32>, {}>({});",
+        gradients.len(),
+        gradients.join(", ")
+    ));
+    put(format!(
+        "const TYPE_BLEND_HALF_WIDTH: f32 = {:?};",
+        profile::TYPE_BLEND_HALF_WIDTH
+    ));
+    s
+}
+
+/// The module named `name`.
+///
+/// # Panics
+/// When no module has that name (a typo in an `#import` line, caught by the shader tests).
+pub fn find(name: &str) -> WgslModule {
+    MODULES
+        .iter()
+        .copied()
+        .find(|m| m.name == name)
+        .unwrap_or_else(|| panic!("no WGSL module named {name:?}"))
+}
+
+/// The modules `source` imports, in the order its `#import` lines name them.
+pub fn imports(source: &str) -> Vec<&str> {
+    source
+        .lines()
+        .filter_map(|line| line.trim().strip_prefix("#import "))
+        .flat_map(str::split_whitespace)
+        .collect()
+}
+
+/// The whole program of root module `root`: the generated constants, then every module it
+/// reaches, each after its imports, without the `#import` lines.
+pub fn program(root: &str) -> String {
+    let mut order = Vec::new();
+    visit(root, &mut HashSet::new(), &mut order);
+    let mut text = constants_wgsl();
+    for m in order {
+        for line in m.source.lines() {
+            if !line.trim_start().starts_with("#import ") {
+                text.push_str(line);
+                text.push('\n');
+            }
+        }
+    }
+    text
+}
+
+/// Depth-first: `name`'s imports, then `name` itself, each module once.
+fn visit(name: &str, seen: &mut HashSet<String>, order: &mut Vec<WgslModule>) {
+    if name == "constants" || !seen.insert(name.to_string()) {
+        return;
+    }
+    let m = find(name);
+    for dependency in imports(m.source) {
+        visit(dependency, seen, order);
+    }
+    order.push(m);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_module_follows_everything_it_imports() {
+        let text = program("raymarch");
+        let at = |marker: &str| {
+            text.find(marker)
+                .unwrap_or_else(|| panic!("{marker} is missing"))
+        };
+        assert!(at("const MAX_LAYERS") < at("struct Field {"));
+        assert!(at("fn noise_pcg_hash") < at("fn frame_pixel_jitter"));
+        assert!(at("struct Field {") < at("fn march_clouds"));
+        assert_eq!(
+            text.matches("struct Field {").count(),
+            1,
+            "each module once"
+        );
+        assert!(!text.contains("#import"));
+    }
+
+    #[test]
+    fn every_module_validates_on_its_own_and_every_program_too() {
+        for m in MODULES {
+            let text = program(m.name);
+            crate::optics::test_support::validate_wgsl(m.name, &text);
+        }
+    }
+
+    #[test]
+    fn imports_are_read_from_the_header() {
+        assert_eq!(
+            imports("#import a b\n#import c\nfn x() {}"),
+            ["a", "b", "c"]
+        );
+    }
+
+    #[test]
+    fn generated_constants_are_the_rust_values() {
+        let text = constants_wgsl();
+        assert!(text.contains(&format!(
+            "const MAX_LAYERS: u32 = {}u;",
+            crate::field::MAX_LAYERS
+        )));
+        assert!(text.contains("vec4<f32>(0.0, 0.07, 0.08, 0.15)"));
+    }
+}

@@ -1,0 +1,59 @@
+//! The technique trait: one way of turning the cloud field into the [`CloudOutput`] contract.
+//!
+//! A technique reads the shared groups ([`Shared`]: field, frame, environment) and the host's
+//! depth buffer, and writes radiance, transmittance and cloud distance for the rays of the frame's
+//! [`crate::output::SampleGrid`]. It never draws the sky, applies haze, tone-maps or keeps history:
+//! temporal reuse, upsampling and compositing serve every technique from its output.
+
+use crate::frame::Shared;
+use crate::gpu::{GpuContext, PassTimer};
+use crate::output::CloudOutput;
+use crate::scene::Scene;
+use glam::UVec2;
+
+/// What a technique counted in a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TechniqueStats {
+    /// Output texels written.
+    pub pixels: u32,
+    /// Extinction evaluations along view rays per texel (zero for techniques that do not march).
+    pub density_samples_per_pixel: f64,
+}
+
+/// Where a technique reads and writes.
+pub struct TechniqueTargets<'a> {
+    /// The host's depth buffer (Depth32Float, at the frame's full resolution, in the frame's
+    /// [`crate::frame::DepthConvention`]).
+    pub host_depth: &'a wgpu::TextureView,
+    /// The output, at the sample grid's resolution.
+    pub output: &'a CloudOutput,
+}
+
+/// One way of rendering the clouds. Made once; [`Technique::prepare`] and [`Technique::encode`]
+/// every frame allocate nothing.
+pub trait Technique {
+    /// The scene-file name (`render.technique`).
+    fn name(&self) -> &'static str;
+
+    /// Takes this frame's settings (steps, lighting, phase function) from `scene`.
+    fn prepare(&mut self, ctx: &GpuContext, scene: &Scene);
+
+    /// Records the technique over the output texels `region` (origin, size): the whole output, or
+    /// one band of it when a long render reports progress (then submit each band before encoding
+    /// the next). Passes are timed under `label` when `timer` is given.
+    fn encode(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        shared: &Shared,
+        targets: &TechniqueTargets,
+        region: (UVec2, UVec2),
+        timer: Option<(&mut PassTimer, &str)>,
+    );
+
+    /// Marks the end of a frame's encoding: copies its statistics out, to be read without waiting.
+    fn finish_frame(&mut self, encoder: &mut wgpu::CommandEncoder);
+
+    /// The statistics of the newest frame the GPU has finished (never waits; None before any).
+    fn stats(&mut self, ctx: &GpuContext) -> Option<TechniqueStats>;
+}

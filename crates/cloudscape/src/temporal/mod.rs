@@ -1,0 +1,353 @@
+//! Temporal reuse for any technique (the volumecloud seed, with Horizon Zero Dawn's subset
+//! updates): the technique renders few rays per frame on a coarse grid, each through a different
+//! sub-pixel and at a different offset along the ray every frame, and this full-resolution resolve
+//! upsamples them with depth awareness, reprojects the history at the cloud distance, clips it to
+//! the neighbourhood and blends. It reads only the cloud output ([`crate::output`]).
+
+use crate::frame::{Frame, Shared};
+use crate::gpu::pipeline::{
+    BindGroupCache, UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d,
+    float_texture, storage_texture_2d, uniform_buffer,
+};
+use crate::gpu::{GpuContext, PassTimer};
+use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT, CloudOutput, SampleGrid};
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, UVec2, Vec2, Vec3};
+
+/// How temporal reuse trades rays for history.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TemporalSettings {
+    /// 1, 2 or 4: march one ray per divisor x divisor block per frame (4 updates 1/16 of the pixels,
+    /// as Horizon Zero Dawn does).
+    pub divisor: u32,
+    /// Weight of new samples per frame at full resolution (the seed's 0.05): pixels without a ray
+    /// of their own this frame blend toward the upsampled estimate by it, and a pixel that gets its
+    /// own ray every divisor^2 frames blends it in with the weight that decays as much over them.
+    pub blend_per_frame: f32,
+    /// Half-width of the neighbourhood box the history is clipped to, in standard deviations (the
+    /// seed's gamma = 1).
+    pub clip_gamma: f32,
+    /// A camera jump longer than this (metres) in one frame is a cut: the history restarts.
+    pub cut_distance_m: f32,
+    /// The history is trusted where the cloud it shows lies within this fraction of the distance
+    /// at which the current estimate puts it; otherwise it shows something else (a disocclusion,
+    /// the inside of a cloud the camera has left) and is dropped.
+    pub distance_tolerance: f32,
+}
+
+impl Default for TemporalSettings {
+    fn default() -> Self {
+        TemporalSettings {
+            divisor: 2,
+            blend_per_frame: 0.05,
+            clip_gamma: 1.0,
+            cut_distance_m: 1000.0,
+            distance_tolerance: 0.25,
+        }
+    }
+}
+
+impl TemporalSettings {
+    /// Weight of a pixel's own fresh sample: 1 - (1 - blend)^(divisor^2).
+    pub fn fresh_weight(&self) -> f32 {
+        1.0 - (1.0 - self.blend_per_frame).powi((self.divisor * self.divisor) as i32)
+    }
+}
+
+/// The radical inverse of `index` in `base` (Halton 1964): a low-discrepancy sequence in [0, 1).
+pub fn halton(mut index: u32, base: u32) -> f32 {
+    let (mut result, mut scale) = (0.0, 1.0);
+    while index > 0 {
+        scale /= base as f32;
+        result += scale * (index % base) as f32;
+        index /= base;
+    }
+    result
+}
+
+/// The sub-pixel of a `divisor` x `divisor` block that frame `index` marches: blocks are visited in
+/// the order of the ordered-dither (Bayer) matrix, so successive frames spread over the block.
+pub fn subpixel(index: u32, divisor: u32) -> UVec2 {
+    let n = divisor * divisor;
+    let rank = index % n;
+    (0..n)
+        .map(|i| UVec2::new(i % divisor, i / divisor))
+        .find(|p| bayer_rank(*p, divisor) == rank)
+        .expect("a Bayer matrix holds every rank once")
+}
+
+/// Rank of `p` in the `size` x `size` Bayer matrix (size a power of two), built by interleaving the
+/// bits of x ^ y and y (Bayer 1973).
+fn bayer_rank(p: UVec2, size: u32) -> u32 {
+    let bits = size.trailing_zeros();
+    (0..bits).fold(0, |rank, b| {
+        let x = (p.x >> b) & 1;
+        let y = (p.y >> b) & 1;
+        rank | (((x ^ y) << 1 | y) << (2 * (bits - 1 - b)))
+    })
+}
+
+/// The `Temporal` uniform of `temporal.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct TemporalUniform {
+    prev_clip_from_world: Mat4,
+    prev_camera_position_m: Vec3,
+    history_valid: u32,
+    wind_shift_m: Vec2,
+    fresh_weight: f32,
+    clip_gamma: f32,
+    unmarched_weight: f32,
+    distance_tolerance: f32,
+    reserved: UVec2,
+}
+
+/// What the previous frame looked like, for reprojection.
+#[derive(Clone, Copy, Debug)]
+struct PreviousFrame {
+    clip_from_world: Mat4,
+    camera_m: Vec3,
+    time_s: f32,
+}
+
+/// The temporal resolve pass and its two full-resolution histories (ping-pong), each with the
+/// cloud distance its pixels show.
+pub struct TemporalResolve {
+    settings: TemporalSettings,
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    uniform: wgpu::Buffer,
+    sampler: wgpu::Sampler,
+    history: Option<[CloudOutput; 2]>,
+    groups: [BindGroupCache; 2],
+    previous: Option<PreviousFrame>,
+    latest: usize,
+}
+
+impl TemporalResolve {
+    /// Builds the pass against the shared groups' layouts.
+    pub fn new(ctx: &GpuContext, shared: &Shared, settings: TemporalSettings) -> TemporalResolve {
+        use wgpu::TextureViewDimension::D2;
+        let unfilterable = wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: D2,
+            multisampled: false,
+        };
+        let sampler_type = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
+        let types = [
+            UNIFORM,
+            float_texture(D2),
+            unfilterable,
+            float_texture(D2),
+            sampler_type,
+            unfilterable,
+            storage_texture_2d(CLOUD_FORMAT),
+            unfilterable,
+            storage_texture_2d(CLOUD_DISTANCE_FORMAT),
+        ];
+        let layout = bind_group_layout(&ctx.device, "temporal resolve", &types);
+        let pipeline = compute_pipeline(
+            ctx,
+            "temporal resolve",
+            &crate::shader::program("temporal"),
+            "resolve_clouds",
+            &shared.layouts(&layout),
+        );
+        let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        TemporalResolve {
+            settings,
+            pipeline,
+            layout,
+            uniform: uniform_buffer(ctx, "temporal", size_of::<TemporalUniform>() as u64),
+            sampler,
+            history: None,
+            groups: Default::default(),
+            previous: None,
+            latest: 0,
+        }
+    }
+
+    /// Forgets the history: the next frame starts afresh (camera cuts, new weather).
+    pub fn reset(&mut self) {
+        self.previous = None;
+    }
+
+    /// The history written last: the resolved full-resolution output (None before any frame).
+    pub fn latest(&self) -> Option<&CloudOutput> {
+        self.history.as_ref().map(|h| &h[self.latest])
+    }
+
+    /// The settings in use.
+    pub fn settings(&self) -> &TemporalSettings {
+        &self.settings
+    }
+
+    /// The rays frame `frame_index` renders: its sub-pixel of each block (Bayer order) and its
+    /// Halton offset along the rays. The frame index must advance every frame.
+    pub fn grid(&self, frame_index: u32) -> SampleGrid {
+        let divisor = self.settings.divisor;
+        SampleGrid {
+            divisor,
+            subpixel: subpixel(frame_index, divisor),
+            temporal_offset: Some(halton(frame_index % 64 + 1, 3)),
+        }
+    }
+
+    /// Records the resolve of this frame's coarse output `current` (rendered on
+    /// [`TemporalResolve::grid`]) into the full-resolution history; returns the result, valid once
+    /// the encoder is submitted. `wind_m_per_s` is the clouds' motion.
+    pub fn encode(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        shared: &Shared,
+        (frame, wind_m_per_s): (&Frame, Vec2),
+        (current, host_depth): (&CloudOutput, &wgpu::TextureView),
+        timer: Option<&mut PassTimer>,
+    ) -> &CloudOutput {
+        self.ensure_history(ctx, frame.size);
+        self.write_uniform(ctx, frame, wind_m_per_s);
+        let (read, write) = (self.latest, 1 - self.latest);
+        let history = self.history.as_ref().expect("ensure_history made it");
+        let (layout, uniform, sampler) = (&self.layout, &self.uniform, &self.sampler);
+        let views = [
+            &current.radiance,
+            &current.distance,
+            &history[read].radiance,
+            host_depth,
+            &history[write].radiance,
+            &history[read].distance,
+            &history[write].distance,
+        ];
+        let group = self.groups[write].get(&views, || {
+            use wgpu::BindingResource::{Sampler, TextureView};
+            bind_group(
+                &ctx.device,
+                layout,
+                &[
+                    uniform.as_entire_binding(),
+                    TextureView(views[0]),
+                    TextureView(views[1]),
+                    TextureView(views[2]),
+                    Sampler(sampler),
+                    TextureView(views[3]),
+                    TextureView(views[4]),
+                    TextureView(views[5]),
+                    TextureView(views[6]),
+                ],
+            )
+        });
+        let writes = timer.and_then(|t| t.compute_pass_writes("temporal resolve"));
+        dispatch_2d(
+            encoder,
+            "temporal resolve",
+            &self.pipeline,
+            &shared.bind_groups(group),
+            frame.size,
+            writes,
+        );
+        self.latest = write;
+        &history[write]
+    }
+
+    fn write_uniform(&mut self, ctx: &GpuContext, frame: &Frame, wind_m_per_s: Vec2) {
+        let clip_from_world = frame.clip_from_world();
+        let cut = self.previous.is_some_and(|p| {
+            p.camera_m.distance(frame.camera_position_m) > self.settings.cut_distance_m
+        });
+        let previous = if cut { None } else { self.previous };
+        let s = &self.settings;
+        let uniform = TemporalUniform {
+            prev_clip_from_world: previous.map_or(clip_from_world, |p| p.clip_from_world),
+            prev_camera_position_m: previous.map_or(frame.camera_position_m, |p| p.camera_m),
+            history_valid: previous.is_some() as u32,
+            wind_shift_m: wind_m_per_s * previous.map_or(0.0, |p| frame.time_s - p.time_s),
+            fresh_weight: s.fresh_weight(),
+            clip_gamma: s.clip_gamma,
+            unmarched_weight: s.blend_per_frame,
+            distance_tolerance: s.distance_tolerance,
+            reserved: UVec2::ZERO,
+        };
+        ctx.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        self.previous = Some(PreviousFrame {
+            clip_from_world,
+            camera_m: frame.camera_position_m,
+            time_s: frame.time_s,
+        });
+    }
+
+    fn ensure_history(&mut self, ctx: &GpuContext, size: UVec2) {
+        if self.history.as_ref().is_some_and(|h| h[0].size == size) {
+            return;
+        }
+        self.history = Some([
+            CloudOutput::new(ctx, "cloud history a", size),
+            CloudOutput::new(ctx, "cloud history b", size),
+        ]);
+        self.previous = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout_check::assert_wgsl_layout;
+
+    #[test]
+    fn temporal_uniform_matches_its_wgsl_layout() {
+        assert_wgsl_layout!(
+            "temporal",
+            "Temporal",
+            TemporalUniform {
+                prev_clip_from_world,
+                prev_camera_position_m,
+                history_valid,
+                wind_shift_m,
+                fresh_weight,
+                clip_gamma,
+                unmarched_weight,
+                distance_tolerance,
+                reserved,
+            }
+        );
+    }
+
+    #[test]
+    fn halton_is_the_radical_inverse() {
+        assert_eq!(halton(1, 2), 0.5);
+        assert_eq!(halton(2, 2), 0.25);
+        assert_eq!(halton(3, 2), 0.75);
+        assert!((halton(1, 3) - 1.0 / 3.0).abs() < 1e-7);
+        assert!((halton(5, 3) - 7.0 / 9.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn subpixels_visit_every_pixel_of_a_block_once() {
+        for divisor in [1, 2, 4] {
+            let mut seen: Vec<UVec2> = (0..divisor * divisor)
+                .map(|i| subpixel(i, divisor))
+                .collect();
+            seen.sort_by_key(|p| (p.y, p.x));
+            seen.dedup();
+            assert_eq!(seen.len() as u32, divisor * divisor);
+        }
+        // Consecutive frames land far apart in the block (ordered dither), not side by side.
+        assert_eq!(subpixel(0, 2), UVec2::new(0, 0));
+        assert_eq!(subpixel(1, 2), UVec2::new(1, 1));
+    }
+
+    #[test]
+    fn fresh_weight_decays_as_the_per_frame_blend_would() {
+        let s = TemporalSettings {
+            divisor: 4,
+            ..TemporalSettings::default()
+        };
+        assert!((s.fresh_weight() - (1.0 - 0.95f32.powi(16))).abs() < 1e-6);
+        assert!((TemporalSettings { divisor: 1, ..s }.fresh_weight() - 0.05).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,390 @@
+//! Every WGSL function with a CPU twin agrees with it on the GPU: the coarse field the light paths
+//! use, camera rays and depth in every convention, aerial perspective, the sun disc, the sky, the
+//! ground, the diffuse transmittance and tone mapping. Also: a live edit of the field reaches the
+//! GPU without regenerating the noise.
+
+use cloudscape::environment::Environment;
+use cloudscape::frame::{DepthConvention, Frame};
+use cloudscape::gpu::GpuContext;
+use cloudscape::optics::diffuse_transmittance;
+use cloudscape::post::tonemap;
+use cloudscape::probe::{Probe, ProbeFunction, ProbeInput};
+use cloudscape::renderer::{CloudRenderer, Reuse};
+use cloudscape::scene::Scene;
+use glam::{UVec2, Vec2, Vec3, Vec4};
+use std::path::Path;
+
+const SIZE: UVec2 = UVec2::new(64, 36);
+
+/// A renderer of `scene` whose shared groups hold `frame`.
+fn renderer(ctx: &GpuContext, scene: &Scene, frame: &Frame) -> CloudRenderer {
+    let mut clouds = CloudRenderer::new(ctx, scene, Path::new(".")).expect("field");
+    clouds.begin_frame(ctx, scene, frame, Reuse::None);
+    clouds
+}
+
+/// `function` at `inputs` on the GPU.
+fn gpu(
+    ctx: &GpuContext,
+    clouds: &CloudRenderer,
+    f: ProbeFunction,
+    inputs: &[ProbeInput],
+) -> Vec<Vec4> {
+    Probe::new(ctx, &clouds.shared()).run(ctx, &clouds.shared(), f, inputs)
+}
+
+fn input(a: Vec4, b: Vec4) -> ProbeInput {
+    ProbeInput { a, b }
+}
+
+/// A deterministic value in [0, 1) for index `i` and stream `k`.
+fn unit(i: u32, k: u32) -> f32 {
+    let h = (i.wrapping_mul(2654435761) ^ k.wrapping_mul(40503)).wrapping_mul(2246822519);
+    (h >> 8) as f32 / (1u32 << 24) as f32
+}
+
+/// A unit direction from index `i`, `y >= y_min`.
+fn direction(i: u32, y_min: f32) -> Vec3 {
+    let y = y_min + (1.0 - y_min) * unit(i, 1);
+    let phi = std::f32::consts::TAU * unit(i, 2);
+    let r = (1.0 - y * y).max(0.0).sqrt();
+    Vec3::new(r * phi.cos(), y, r * phi.sin())
+}
+
+/// Asserts `gpu` and `cpu` agree within `tolerance` relative to `scale`, for every component.
+fn assert_close(name: &str, gpu: &[Vec4], cpu: &[Vec4], tolerance: f32) {
+    assert_eq!(gpu.len(), cpu.len());
+    for (i, (g, c)) in gpu.iter().zip(cpu).enumerate() {
+        let scale = c.abs().max_element().max(1.0);
+        let error = (*g - *c).abs().max_element() / scale;
+        assert!(error <= tolerance, "{name} #{i}: GPU {g} vs CPU {c}");
+    }
+}
+
+#[test]
+fn coarse_field_and_its_light_paths_match_the_cpu() {
+    let ctx = GpuContext::for_tests();
+    let mut scene = Scene::default();
+    scene.layers[0].coverage = 0.7;
+    let frame = Frame::from_scene(&scene, SIZE);
+    let clouds = renderer(&ctx, &scene, &frame);
+    let field = clouds.field();
+    let layer = &scene.layers[0];
+    let points: Vec<Vec3> = (0..1500)
+        .map(|i| {
+            let h = layer.bottom_m + layer.thickness_m * unit(i, 3);
+            Vec3::new(
+                16000.0 * unit(i, 4) - 8000.0,
+                h,
+                16000.0 * unit(i, 5) - 8000.0,
+            )
+        })
+        .collect();
+    let inputs: Vec<ProbeInput> = points
+        .iter()
+        .map(|p| input(p.extend(0.0), Vec4::ZERO))
+        .collect();
+    let got = gpu(&ctx, &clouds, ProbeFunction::CoarseExtinction, &inputs);
+    let want: Vec<f32> = points
+        .iter()
+        .map(|p| field.coarse_extinction_per_m(*p, 0.0))
+        .collect();
+    let cloudy = want.iter().filter(|w| **w > 0.0).count();
+    assert!(cloudy > 300, "only {cloudy} points in cloud");
+    let mut diffs: Vec<f32> = got
+        .iter()
+        .zip(&want)
+        .map(|(g, w)| (g.x - w).abs())
+        .collect();
+    diffs.sort_by(f32::total_cmp);
+    let p99 = diffs[diffs.len() * 99 / 100];
+    assert!(
+        p99 < 0.02 * layer.extinction_per_m,
+        "coarse extinction p99 {p99}"
+    );
+
+    // Light paths: doubling segments toward the sun and uniform ones up from the ground.
+    let sun = Environment::from_scene(&scene).sun.direction;
+    let paths: Vec<(Vec3, Vec3, f32, f32)> = (0..200)
+        .map(|i| {
+            let (dir, growth) = if i % 2 == 0 {
+                (sun, 2.0)
+            } else {
+                (Vec3::Y, 1.0)
+            };
+            (points[i as usize], dir, 300.0 + 3000.0 * unit(i, 6), growth)
+        })
+        .collect();
+    let inputs: Vec<ProbeInput> = paths
+        .iter()
+        .map(|(p, d, len, growth)| input(p.extend(*len), d.extend(*growth)))
+        .collect();
+    let got = gpu(&ctx, &clouds, ProbeFunction::CoarseOpticalDepth, &inputs);
+    let mut errors: Vec<f32> = paths
+        .iter()
+        .zip(&got)
+        .map(|((p, d, len, growth), g)| {
+            let want = field.coarse_optical_depth((*p, *d), (0.0, *len, *growth), (16, 0.5), 0.0);
+            (g.x - want).abs() / want.max(1.0)
+        })
+        .collect();
+    errors.sort_by(f32::total_cmp);
+    // As for the extinction: texture filtering differs at a few samples near coverage thresholds.
+    let (p95, worst) = (errors[errors.len() * 95 / 100], errors[errors.len() - 1]);
+    assert!(
+        p95 < 0.02 && worst < 0.15,
+        "coarse optical depth differs by p95 {p95}, worst {worst} (relative)"
+    );
+}
+
+#[test]
+fn camera_rays_and_depth_match_the_cpu_in_every_convention() {
+    let ctx = GpuContext::for_tests();
+    let scene = Scene::default();
+    for convention in DepthConvention::ALL {
+        let frame = Frame::from_scene(&scene, SIZE).with_depth(&scene, convention);
+        let clouds = renderer(&ctx, &scene, &frame);
+        let pixels: Vec<Vec2> = (0..100)
+            .map(|i| Vec2::new(unit(i, 7) * SIZE.x as f32, unit(i, 8) * SIZE.y as f32))
+            .collect();
+        let rays: Vec<ProbeInput> = pixels
+            .iter()
+            .map(|p| input(p.extend(0.0).extend(0.0), Vec4::ZERO))
+            .collect();
+        let got = gpu(&ctx, &clouds, ProbeFunction::CameraRay, &rays);
+        let want: Vec<Vec4> = pixels
+            .iter()
+            .map(|p| frame.camera_ray(*p).1.extend(0.0))
+            .collect();
+        assert_close(&format!("{convention:?} ray"), &got, &want, 1e-5);
+        let depths: Vec<(Vec2, f32)> = pixels
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let distance_m = 5.0 + 30000.0 * unit(i as u32, 9);
+                (
+                    *p,
+                    convention.depth_of_distance(&frame.clip_from_view, distance_m),
+                )
+            })
+            .chain([(pixels[0], convention.far_value())])
+            .collect();
+        let inputs: Vec<ProbeInput> = depths
+            .iter()
+            .map(|(p, z)| input(Vec4::new(p.x, p.y, *z, 0.0), Vec4::ZERO))
+            .collect();
+        let got = gpu(&ctx, &clouds, ProbeFunction::DepthDistance, &inputs);
+        let want: Vec<Vec4> = depths
+            .iter()
+            .map(|(p, z)| Vec4::splat(frame.depth_distance_m(*p, *z).min(1.0e30)))
+            .collect();
+        // The GPU and the CPU invert the projection in their own f32 order; a standard depth
+        // buffer resolves tens of kilometres only to about 1 %.
+        let tolerance = if convention.is_reversed() { 2e-3 } else { 2e-2 };
+        assert_close(
+            &format!("{convention:?} depth distance"),
+            &got,
+            &want,
+            tolerance,
+        );
+    }
+}
+
+#[test]
+fn environment_functions_match_the_cpu() {
+    let ctx = GpuContext::for_tests();
+    let mut scene = Scene::default();
+    scene.sky.visibility_m = 20_000.0;
+    let frame = Frame::from_scene(&scene, SIZE);
+    let clouds = renderer(&ctx, &scene, &frame);
+    let env = Environment::from_scene(&scene);
+    // Directions around the sun disc's edge as well as all over the sky.
+    let radius = env.sun.cos_radius.acos();
+    let around_sun = |i: u32| {
+        let tilt = glam::Quat::from_axis_angle(
+            direction(i, -1.0).cross(env.sun.direction).normalize(),
+            radius * (0.5 + unit(i, 10)),
+        );
+        tilt * env.sun.direction
+    };
+    let dirs: Vec<Vec3> = (0..300)
+        .map(|i| {
+            if i % 2 == 0 {
+                around_sun(i)
+            } else {
+                direction(i, -0.3)
+            }
+        })
+        .collect();
+    let inputs: Vec<ProbeInput> = dirs
+        .iter()
+        .map(|d| input(d.extend(0.0), Vec4::ZERO))
+        .collect();
+    let disc = gpu(&ctx, &clouds, ProbeFunction::SunDiscRadiance, &inputs);
+    let inside = disc.iter().filter(|v| v.x > 0.0).count();
+    assert!(
+        inside > 30 && inside < 150,
+        "{inside} directions see the disc"
+    );
+    let want: Vec<Vec4> = dirs
+        .iter()
+        .map(|d| env.sun.radiance(*d).extend(0.0))
+        .collect();
+    // At the rim a direction may fall on either side in f32: count disagreements, not values.
+    let disagree = disc
+        .iter()
+        .zip(&want)
+        .filter(|(g, w)| (**g - **w).abs().max_element() > 1e-3 * w.max_element().max(1.0))
+        .count();
+    assert!(
+        disagree <= 2,
+        "{disagree} sun-disc radiances differ from SunDisc::radiance"
+    );
+    let sky = gpu(&ctx, &clouds, ProbeFunction::SkyRadiance, &inputs);
+    let want: Vec<Vec4> = dirs
+        .iter()
+        .map(|d| env.sky.radiance(*d).extend(0.0))
+        .collect();
+    assert_close("sky", &sky, &want, 1e-5);
+
+    let hazes: Vec<ProbeInput> = (0..100)
+        .map(|i| {
+            input(
+                Vec3::splat(4.0 * unit(i, 11)).extend(unit(i, 12)),
+                Vec4::splat(40_000.0 * unit(i, 13)),
+            )
+        })
+        .collect();
+    let got = gpu(&ctx, &clouds, ProbeFunction::AerialPerspective, &hazes);
+    let want: Vec<Vec4> = hazes
+        .iter()
+        .map(|h| {
+            env.aerial_perspective(h.a.truncate(), h.a.w, h.b.x)
+                .extend(0.0)
+        })
+        .collect();
+    assert_close("aerial perspective", &got, &want, 1e-4);
+
+    let albedo = Vec3::new(0.1, 0.3, 0.2);
+    let got = gpu(
+        &ctx,
+        &clouds,
+        ProbeFunction::GroundRadiance,
+        &[input(albedo.extend(0.0), Vec4::ZERO)],
+    );
+    assert_close(
+        "ground",
+        &got,
+        &[env.ground_radiance(albedo).extend(0.0)],
+        1e-5,
+    );
+
+    let taus: Vec<ProbeInput> = (0..50)
+        .map(|i| input(Vec4::splat(100.0 * unit(i, 14)), Vec4::ZERO))
+        .collect();
+    let got = gpu(&ctx, &clouds, ProbeFunction::DiffuseTransmittance, &taus);
+    let want: Vec<Vec4> = taus
+        .iter()
+        .map(|t| Vec4::splat(diffuse_transmittance(t.a.x, frame.cloud_mean_cosine)))
+        .collect();
+    assert_close("diffuse transmittance", &got, &want, 1e-5);
+}
+
+#[test]
+fn tone_mapping_matches_the_cpu() {
+    let ctx = GpuContext::for_tests();
+    let scene = Scene::default();
+    let clouds = renderer(&ctx, &scene, &Frame::from_scene(&scene, SIZE));
+    let colours: Vec<Vec3> = (0..200)
+        .map(|i| Vec3::new(unit(i, 15), unit(i, 16), unit(i, 17)) * 8.0 * unit(i, 18))
+        .collect();
+    let inputs: Vec<ProbeInput> = colours
+        .iter()
+        .map(|c| input(c.extend(0.0), Vec4::ZERO))
+        .collect();
+    let cases: [(ProbeFunction, fn(Vec3) -> Vec3); 3] = [
+        (ProbeFunction::ToneMapAces, tonemap::tonemap_aces),
+        (ProbeFunction::ToneMapAgx, tonemap::tonemap_agx),
+        (ProbeFunction::LinearToSrgb, |c| {
+            c.map(tonemap::linear_to_srgb)
+        }),
+    ];
+    for (function, cpu) in cases {
+        let got = gpu(&ctx, &clouds, function, &inputs);
+        let want: Vec<Vec4> = colours.iter().map(|c| cpu(*c).extend(0.0)).collect();
+        assert_close(&format!("{function:?}"), &got, &want, 2e-4);
+    }
+}
+
+#[test]
+fn a_live_edit_reaches_the_gpu_without_new_noise() {
+    let ctx = GpuContext::for_tests();
+    let mut scene = Scene::default();
+    let frame = Frame::from_scene(&scene, SIZE);
+    let mut clouds = renderer(&ctx, &scene, &frame);
+    let layer = scene.layers[0].clone();
+    let points: Vec<Vec3> = (0..800)
+        .map(|i| {
+            Vec3::new(
+                12000.0 * unit(i, 19) - 6000.0,
+                layer.bottom_m + layer.thickness_m * unit(i, 20),
+                12000.0 * unit(i, 21) - 6000.0,
+            )
+        })
+        .collect();
+    let inputs: Vec<ProbeInput> = points
+        .iter()
+        .map(|p| input(p.extend(0.0), Vec4::ZERO))
+        .collect();
+    let before = gpu(&ctx, &clouds, ProbeFunction::Extinction, &inputs);
+    scene.layers[0].coverage = 0.85;
+    scene.layers[0].wind_m_per_s = [30.0, 0.0];
+    let update = clouds
+        .update_scene(&ctx, &scene, Path::new("."))
+        .expect("valid edit");
+    assert!(
+        !update.noise_regenerated,
+        "coverage and wind must not regenerate the noise"
+    );
+    clouds.begin_frame(
+        &ctx,
+        &scene,
+        &Frame {
+            time_s: 20.0,
+            ..frame
+        },
+        Reuse::None,
+    );
+    let after = gpu(&ctx, &clouds, ProbeFunction::Extinction, &inputs);
+    let cpu: Vec<f32> = points
+        .iter()
+        .map(|p| clouds.field().extinction_per_m(*p, 20.0))
+        .collect();
+    let mut diffs: Vec<f32> = after
+        .iter()
+        .zip(&cpu)
+        .map(|(g, c)| (g.x - c).abs())
+        .collect();
+    diffs.sort_by(f32::total_cmp);
+    assert!(
+        diffs[diffs.len() * 99 / 100] < 0.02 * layer.extinction_per_m,
+        "the GPU shows the edited field"
+    );
+    let changed = before
+        .iter()
+        .zip(&after)
+        .filter(|(b, a)| (b.x - a.x).abs() > 1e-4)
+        .count();
+    assert!(
+        changed > 100,
+        "the edit changed only {changed} of the points"
+    );
+    scene.noise.seed += 1;
+    let update = clouds
+        .update_scene(&ctx, &scene, Path::new("."))
+        .expect("valid edit");
+    assert!(
+        update.noise_regenerated,
+        "a new noise seed regenerates the noise"
+    );
+}
