@@ -6,6 +6,12 @@
 //! trait; the shared frame state ([`frame`], [`environment`]) and the shared passes ([`temporal`],
 //! [`post`]) serve every technique. [`renderer::CloudRenderer`] hosts them on a game engine's
 //! device; [`renderer::SceneRenderer`] renders whole scenes offline.
+//!
+//! Cargo features, all off by default (without them the crate builds no C or C++ and no image
+//! codec): `png` (PNG files of [`image::LdrImage`], weather maps from PNG files), `exr` (OpenEXR
+//! files of [`image::HdrImage`]), `gif` (the animated preview `animation::GifPreview`), `flip`
+//! (FLIP and HDR-FLIP comparison through NVIDIA's C++ FLIP), and `full` for all of them. Asking a
+//! build for a file type it lacks is an error that names the feature.
 
 pub mod animation;
 pub mod environment;

@@ -290,6 +290,9 @@ fn environment_functions_match_the_cpu() {
     assert_close("diffuse transmittance", &got, &want, 1e-5);
 }
 
+/// A CPU tone-mapping function.
+type ColourMap = fn(Vec3) -> Vec3;
+
 #[test]
 fn tone_mapping_matches_the_cpu() {
     let ctx = GpuContext::for_tests();
@@ -302,7 +305,7 @@ fn tone_mapping_matches_the_cpu() {
         .iter()
         .map(|c| input(c.extend(0.0), Vec4::ZERO))
         .collect();
-    let cases: [(ProbeFunction, fn(Vec3) -> Vec3); 3] = [
+    let cases: [(ProbeFunction, ColourMap); 3] = [
         (ProbeFunction::ToneMapAces, tonemap::tonemap_aces),
         (ProbeFunction::ToneMapAgx, tonemap::tonemap_agx),
         (ProbeFunction::LinearToSrgb, |c| {

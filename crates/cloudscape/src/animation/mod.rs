@@ -9,14 +9,16 @@
 //! `scene_at(scene, t)` with it. The renderer's cloud field is built from the layers, so a
 //! sequence whose coverage changes (`coverage_scale`) needs a new renderer whenever the layers of
 //! the still differ from the previous frame's (`cloudscape animate` does this); camera, sun and
-//! wind need none. [`GifPreview`] turns the frames into an animated GIF.
+//! wind need none. `GifPreview` (cargo feature `gif`) turns the frames into an animated GIF.
 
 mod camera;
+#[cfg(feature = "gif")]
 mod preview;
 mod spline;
 mod sun;
 
 pub use camera::{Aim, CameraPose, camera_at, unwrap_yaw_deg};
+#[cfg(feature = "gif")]
 pub use preview::{GifPreview, PreviewError, preview_size};
 pub use spline::{SplineValue, catmull_rom, velocity_at_key};
 pub use sun::{SunAngles, sun_at};

@@ -1,4 +1,5 @@
-//! [`GifPreview`]: an animated GIF of a frame sequence, small enough to open anywhere.
+//! [`GifPreview`]: an animated GIF of a frame sequence, small enough to open anywhere (cargo
+//! feature `gif`).
 
 use std::path::{Path, PathBuf};
 

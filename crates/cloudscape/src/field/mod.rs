@@ -35,7 +35,8 @@ pub const MAX_LAYERS: usize = 4;
 pub const MAX_VOLUMES: usize = 4;
 
 /// A field that could not be built: which scene key is at fault, and why.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{key_path}: {message}")]
 pub struct FieldError {
     /// Dotted key path in the scene ("weather.path", "volumes.0.path").
     pub key_path: String,

@@ -19,7 +19,8 @@ pub struct Weather {
 }
 
 impl Weather {
-    /// Builds the map a scene describes; a file map is read from `file` (already resolved).
+    /// Builds the map a scene describes; a file map is read from `file` (already resolved), a PNG
+    /// that needs the cargo feature `png`.
     pub fn from_scene(map: &WeatherMap, file: Option<&Path>) -> Result<Weather, String> {
         let extent = map.extent_km * 1000.0;
         match (map.source, file) {
@@ -52,6 +53,8 @@ impl Weather {
     }
 }
 
+/// Reads a PNG weather map (cargo feature `png`).
+#[cfg(feature = "png")]
 fn read_png(path: &Path) -> Result<Texture8, String> {
     let img = image::open(path)
         .map_err(|e| format!("cannot read weather map {}: {e}", path.display()))?;
@@ -59,6 +62,16 @@ fn read_png(path: &Path) -> Result<Texture8, String> {
     let dims = UVec3::new(rgba.width(), rgba.height(), 1);
     let texels = rgba.pixels().map(|p| p.0).collect();
     Ok(Texture8 { dims, texels })
+}
+
+/// Without the `png` feature a weather map file is an error that names the feature.
+#[cfg(not(feature = "png"))]
+fn read_png(path: &Path) -> Result<Texture8, String> {
+    Err(format!(
+        "cannot read weather map {}: this build of cloudscape reads no PNG files; enable the `png` \
+         cargo feature of cloudscape, or use weather.source = \"procedural\"",
+        path.display()
+    ))
 }
 
 /// A procedural map: coverage and type are periodic Perlin fBm with `cells` features across the

@@ -3,8 +3,9 @@
 // member). Bound once, at group 1, in every program that uses it.
 
 struct Frame {
-    world_from_clip: mat4x4<f32>,
     clip_from_world: mat4x4<f32>,   // for raster passes
+    view_from_clip: mat4x4<f32>,    // inverse projection: rays relative to the camera
+    world_from_view: mat4x4<f32>,   // inverse view transform
     camera_position_m: vec3<f32>,
     far_m: f32,                     // nothing beyond this distance is marched
     ground_albedo: vec3<f32>,       // Lambertian albedo (0 without a ground)
@@ -28,11 +29,17 @@ fn frame_ndc(pixel: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(2.0 * pixel.x / frame.viewport_px.x - 1.0, 1.0 - 2.0 * pixel.y / frame.viewport_px.y);
 }
 
+// The view-space point (relative to the camera: no cancellation against its world position) that
+// normalised depth `depth` stores at pixel coordinates `pixel`.
+fn frame_view_point(pixel: vec2<f32>, depth: f32) -> vec3<f32> {
+    let p = frame.view_from_clip * vec4<f32>(frame_ndc(pixel), depth, 1.0);
+    return p.xyz / p.w;
+}
+
 // Unit direction of the ray through pixel coordinates `pixel` (y down), as Frame::camera_ray: the
 // point at normalised depth 0.5 lies between the planes in every depth convention.
 fn frame_ray_direction(pixel: vec2<f32>) -> vec3<f32> {
-    let p = frame.world_from_clip * vec4<f32>(frame_ndc(pixel), 0.5, 1.0);
-    return normalize(p.xyz / p.w - frame.camera_position_m);
+    return normalize((frame.world_from_view * vec4<f32>(frame_view_point(pixel, 0.5), 0.0)).xyz);
 }
 
 // Whether a host depth-buffer value holds geometry (not the cleared value).
@@ -51,8 +58,7 @@ fn frame_depth_distance(pixel: vec2<f32>, depth: f32) -> f32 {
     if !frame_has_geometry(depth) {
         return 3.0e38;
     }
-    let p = frame.world_from_clip * vec4<f32>(frame_ndc(pixel), depth, 1.0);
-    return length(p.xyz / p.w - frame.camera_position_m);
+    return length(frame_view_point(pixel, depth));
 }
 
 // A per-pixel, per-frame value in [0, 1): white noise from the PCG hash (noise.wgsl), which turns

@@ -10,8 +10,9 @@ use glam::{Mat4, UVec2, Vec2, Vec3};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct FrameUniform {
-    world_from_clip: Mat4,
     clip_from_world: Mat4,
+    view_from_clip: Mat4,
+    world_from_view: Mat4,
     camera_position_m: Vec3,
     far_m: f32,
     ground_albedo: Vec3,
@@ -31,10 +32,10 @@ pub struct FrameUniform {
 impl FrameUniform {
     /// The uniform of `frame` with a technique output sampled on `grid`.
     pub fn new(frame: &Frame, grid: &SampleGrid) -> FrameUniform {
-        let clip_from_world = frame.clip_from_world();
         FrameUniform {
-            world_from_clip: clip_from_world.inverse(),
-            clip_from_world,
+            clip_from_world: frame.clip_from_world(),
+            view_from_clip: frame.clip_from_view.inverse(),
+            world_from_view: frame.view_from_world.inverse(),
             camera_position_m: frame.camera_position_m,
             far_m: frame.far_m,
             ground_albedo: frame.ground_albedo.unwrap_or(Vec3::ZERO),
@@ -68,8 +69,9 @@ mod tests {
             "probe",
             "Frame",
             FrameUniform {
-                world_from_clip,
                 clip_from_world,
+                view_from_clip,
+                world_from_view,
                 camera_position_m,
                 far_m,
                 ground_albedo,

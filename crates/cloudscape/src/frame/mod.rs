@@ -115,12 +115,16 @@ impl Frame {
     /// World-space ray (origin, unit direction) through pixel coordinates `pixel` (0..width,
     /// 0..height, y down): `frame_ray_direction` in `frame.wgsl`.
     pub fn camera_ray(&self, pixel: glam::Vec2) -> (Vec3, Vec3) {
-        let world_from_clip = self.clip_from_world().inverse();
-        let p = world_from_clip.project_point3(self.ndc(pixel).extend(RAY_NDC_DEPTH));
-        (
-            self.camera_position_m,
-            (p - self.camera_position_m).normalize(),
-        )
+        let to_point = self.view_point(pixel, RAY_NDC_DEPTH);
+        let world = self.view_from_world.inverse().transform_vector3(to_point);
+        (self.camera_position_m, world.normalize())
+    }
+
+    /// The view-space point (relative to the camera, so with no cancellation against its world
+    /// position) that normalised depth `depth` stores at `pixel`.
+    fn view_point(&self, pixel: glam::Vec2, depth: f32) -> Vec3 {
+        let p = self.clip_from_view.inverse() * self.ndc(pixel).extend(depth).extend(1.0);
+        p.truncate() / p.w
     }
 
     /// Distance from the camera to what a depth-buffer value `depth` stores at `pixel`, infinite
@@ -129,9 +133,7 @@ impl Frame {
         if !self.depth.has_geometry(depth) {
             return f32::INFINITY;
         }
-        let world_from_clip = self.clip_from_world().inverse();
-        let p = world_from_clip * self.ndc(pixel).extend(depth).extend(1.0);
-        (p.truncate() / p.w - self.camera_position_m).length()
+        self.view_point(pixel, depth).length()
     }
 
     /// The `Frame` uniform of `frame.wgsl` for a technique output sampled on `grid`.

@@ -151,6 +151,24 @@ impl GpuContext {
         })
     }
 
+    /// Wraps a device, queue and adapter the host renderer already owns (a game engine's): the
+    /// library then renders on the host's device, into textures the host can sample or present.
+    /// The device needs no feature beyond WebGPU's defaults; with
+    /// [`wgpu::Features::TIMESTAMP_QUERY`] passes can be timed.
+    pub fn from_wgpu(
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> GpuContext {
+        let info = adapter.get_info();
+        GpuContext {
+            device,
+            queue,
+            adapter,
+            info,
+        }
+    }
+
     /// The chosen adapter's name, backend, type and driver.
     pub fn adapter_info(&self) -> &wgpu::AdapterInfo {
         &self.info

@@ -85,22 +85,6 @@ impl PassTimer {
         })
     }
 
-    /// Timestamp writes for two passes encoded by one call (a pass and the pass that consumes it).
-    pub fn compute_pass_writes_pair(
-        &mut self,
-        first: &str,
-        second: &str,
-    ) -> [Option<wgpu::ComputePassTimestampWrites<'_>>; 2] {
-        let (a, b) = (self.reserve(first), self.reserve(second));
-        match self.queries.as_ref() {
-            Some(q) => [
-                a.map(|i| pass_writes(&q.set, i)),
-                b.map(|i| pass_writes(&q.set, i)),
-            ],
-            None => [None, None],
-        }
-    }
-
     /// Claims the next pair of query slots for `label`.
     fn reserve(&mut self, label: &str) -> Option<u32> {
         self.queries.as_ref()?;

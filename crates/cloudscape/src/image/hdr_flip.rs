@@ -8,7 +8,8 @@
 //! deviation: the tone mapper is this crate's ACES (Hill's fit, the one the renderer shows)
 //! instead of FLIP's Narkowicz fit; `x` is found for it numerically.
 
-use super::compare::{check_same_size, flip_error_map, summarise};
+use super::compare::check_same_size;
+use super::flip::{flip_error_map, summarise};
 use super::{FlipStats, HdrImage, ImageError};
 use crate::post::tonemap::tonemap_aces;
 use crate::scene::Tonemap;

@@ -1,14 +1,27 @@
 //! Images: linear HDR frames and sRGB display frames, their files (OpenEXR, PNG) and their
 //! comparison (FLIP, HDR-FLIP, relative MSE).
 //!
-//! Pixels are stored row by row from the top-left corner.
+//! Pixels are stored row by row from the top-left corner. The images, tone mapping and relative
+//! MSE need no cargo feature; files need `png` or `exr`, FLIP and HDR-FLIP need `flip`.
 
 mod compare;
+#[cfg(feature = "exr")]
+mod exr;
+#[cfg(feature = "flip")]
+mod flip;
+#[cfg(feature = "flip")]
 mod hdr_flip;
+#[cfg(any(feature = "png", feature = "exr"))]
 mod io;
+#[cfg(feature = "png")]
+mod png;
 
-pub use compare::{FlipStats, flip, relative_mse};
+pub use compare::relative_mse;
+#[cfg(feature = "flip")]
+pub use flip::{FlipStats, flip};
+#[cfg(feature = "flip")]
 pub use hdr_flip::{ExposureRange, hdr_flip};
+#[cfg(any(feature = "png", feature = "exr"))]
 pub use io::write_image;
 
 use std::path::PathBuf;
@@ -16,7 +29,7 @@ use std::path::PathBuf;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::post::tonemap::{display_rgb8, quantize_u8};
+use crate::post::tonemap::{display_rgb8, quantize_u8, srgb_to_linear};
 use crate::scene::Tonemap;
 
 /// A linear HDR image: radiance RGB (scene radiometric units) and alpha (coverage, 0..1).
@@ -50,6 +63,18 @@ pub enum ImageError {
         /// The file.
         path: PathBuf,
     },
+    /// The file type is known, but this build of cloudscape lacks the cargo feature that reads and
+    /// writes it.
+    #[error(
+        "{}: this build of cloudscape cannot read or write .{feature} files; enable the `{feature}` cargo feature of cloudscape",
+        path.display()
+    )]
+    MissingFeature {
+        /// The file.
+        path: PathBuf,
+        /// The cargo feature (`png` or `exr`), also the file name extension.
+        feature: &'static str,
+    },
     /// The operating system refused to create, write, rename or read the file.
     #[error("{}: {source}", path.display())]
     Io {
@@ -59,6 +84,7 @@ pub enum ImageError {
         source: std::io::Error,
     },
     /// The PNG encoder or decoder failed.
+    #[cfg(feature = "png")]
     #[error("{}: PNG: {source}", path.display())]
     Png {
         /// The file.
@@ -67,12 +93,13 @@ pub enum ImageError {
         source: ::image::ImageError,
     },
     /// The OpenEXR encoder or decoder failed.
+    #[cfg(feature = "exr")]
     #[error("{}: OpenEXR: {source}", path.display())]
     Exr {
         /// The file.
         path: PathBuf,
         /// The `exr` crate's error.
-        source: exr::error::Error,
+        source: ::exr::error::Error,
     },
     /// The pixel buffer does not hold `width * height` pixels, or the image is empty.
     #[error("image of {width}x{height} pixels holds {len} pixels (expected width * height > 0)")]
@@ -164,11 +191,53 @@ impl LdrImage {
             })
             .collect()
     }
+
+    /// The linear image: RGB decoded from sRGB (IEC 61966-2-1), alpha scaled to 0..1.
+    pub fn to_linear(&self) -> HdrImage {
+        let decode = |v: u8| srgb_to_linear(f32::from(v) / 255.0);
+        let pixels = self
+            .pixels
+            .iter()
+            .map(|&[r, g, b, a]| [decode(r), decode(g), decode(b), f32::from(a) / 255.0])
+            .collect();
+        HdrImage {
+            width: self.width,
+            height: self.height,
+            pixels,
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A 4x3 HDR image over several decades, with varying alpha (the file tests' sample).
+    pub(super) fn hdr_sample() -> HdrImage {
+        let pixels = (0..12u8)
+            .map(|i| {
+                let v = f32::from(i);
+                [v * 0.37, 1e4 * v, 1.0 / (v + 1.0), v / 11.0]
+            })
+            .collect();
+        HdrImage {
+            width: 4,
+            height: 3,
+            pixels,
+        }
+    }
+
+    /// A 5x3 display image with varying alpha (the file tests' sample).
+    pub(super) fn ldr_sample() -> LdrImage {
+        let pixels = (0..15u8)
+            .map(|i| [i * 17, 255 - i, i * 3, 128 + i])
+            .collect();
+        LdrImage {
+            width: 5,
+            height: 3,
+            pixels,
+        }
+    }
 
     #[test]
     fn to_ldr_tonemaps_every_pixel() {

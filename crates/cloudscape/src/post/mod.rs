@@ -92,7 +92,7 @@ impl Compositor {
         ];
         let layout = &self.layout;
         let group = self.group.get(&views, || {
-            let resources = views.map(|v| wgpu::BindingResource::TextureView(v));
+            let resources = views.map(wgpu::BindingResource::TextureView);
             bind_group(&ctx.device, layout, &resources)
         });
         let writes = timer.and_then(|t| t.compute_pass_writes("compose"));
