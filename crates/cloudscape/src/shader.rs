@@ -135,6 +135,13 @@ pub fn program(root: &str) -> String {
     text
 }
 
+/// The names of the modules program `root` reaches, `root` included.
+pub fn reached(root: &str) -> Vec<&'static str> {
+    let mut order = Vec::new();
+    visit(root, &mut HashSet::new(), &mut order);
+    order.into_iter().map(|m| m.name).collect()
+}
+
 /// Depth-first: `name`'s imports, then `name` itself, each module once.
 fn visit(name: &str, seen: &mut HashSet<String>, order: &mut Vec<WgslModule>) {
     if name == "constants" || !seen.insert(name.to_string()) {

@@ -8,36 +8,39 @@ use cloudscape::renderer::{CloudRenderer, Reuse};
 use cloudscape::scene::Scene;
 use glam::UVec2;
 
-/// Renders the default scene over a depth buffer of `convention` cleared to the depth of a wall
-/// `wall_m` away (None: no geometry); returns (rgb radiance sum, mean transmittance).
-fn clouds_over_depth(convention: DepthConvention, wall_m: Option<f32>) -> (f32, f32) {
-    let ctx = GpuContext::for_tests();
+/// The default scene's renderer, begun on a frame of `convention` at 64x36.
+fn begun(ctx: &GpuContext, convention: DepthConvention) -> (CloudRenderer, Frame) {
     let mut scene = Scene::default();
     scene.camera.pitch_deg = 35.0;
     scene.layers[0].coverage = 0.8;
     scene.render.quality = cloudscape::scene::Quality::Low;
-    let size = UVec2::new(64, 36);
-    let frame = Frame::from_scene(&scene, size).with_depth(&scene, convention);
-    let depth = wall_m.map_or(convention.far_value(), |d| {
-        convention.depth_of_distance(&frame.clip_from_view, d)
-    });
-    let mut clouds = CloudRenderer::new(&ctx, &scene, std::path::Path::new(".")).expect("field");
-    clouds.begin_frame(&ctx, &scene, &frame, Reuse::None);
+    let frame = Frame::from_scene(&scene, UVec2::new(64, 36)).with_depth(&scene, convention);
+    let mut clouds = CloudRenderer::new(ctx, &scene, std::path::Path::new(".")).expect("field");
+    clouds.begin_frame(ctx, &scene, &frame, Reuse::None);
+    (clouds, frame)
+}
+
+/// A depth buffer of `size` cleared to `depth`, recorded into `encoder`.
+fn depth_buffer(
+    ctx: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    size: UVec2,
+    depth: f32,
+) -> wgpu::TextureView {
     use wgpu::TextureUsages as U;
     let depth_texture = cloudscape::gpu::pipeline::texture_2d(
-        &ctx,
+        ctx,
         "host depth",
         size,
         wgpu::TextureFormat::Depth32Float,
         U::TEXTURE_BINDING | U::RENDER_ATTACHMENT,
     );
-    let depth_view = depth_texture.create_view(&Default::default());
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    let view = depth_texture.create_view(&Default::default());
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("host geometry"),
         color_attachments: &[],
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: &depth_view,
+            view: &view,
             depth_ops: Some(wgpu::Operations {
                 load: wgpu::LoadOp::Clear(depth),
                 store: wgpu::StoreOp::Store,
@@ -46,6 +49,19 @@ fn clouds_over_depth(convention: DepthConvention, wall_m: Option<f32>) -> (f32, 
         }),
         ..Default::default()
     });
+    view
+}
+
+/// Renders the default scene over a depth buffer of `convention` cleared to the depth of a wall
+/// `wall_m` away (None: no geometry); returns (rgb radiance sum, mean transmittance).
+fn clouds_over_depth(convention: DepthConvention, wall_m: Option<f32>) -> (f32, f32) {
+    let ctx = GpuContext::for_tests();
+    let (mut clouds, frame) = begun(&ctx, convention);
+    let depth = wall_m.map_or(convention.far_value(), |d| {
+        convention.depth_of_distance(&frame.clip_from_view, d)
+    });
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    let depth_view = depth_buffer(&ctx, &mut encoder, frame.size, depth);
     clouds.encode_clouds(&ctx, &mut encoder, &depth_view, None, None);
     ctx.queue.submit([encoder.finish()]);
     let pixels = read_texture_rgba16f(&ctx, clouds.images().clouds.radiance_texture());
@@ -67,4 +83,36 @@ fn geometry_in_front_of_the_layer_hides_the_clouds_in_every_depth_convention() {
             "{convention:?}: an empty depth buffer shows the clouds: T = {transmittance}"
         );
     }
+}
+
+#[test]
+fn statistics_come_back_without_waiting() {
+    let ctx = GpuContext::for_tests();
+    let (mut clouds, frame) = begun(&ctx, DepthConvention::Standard);
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    let depth = depth_buffer(&ctx, &mut encoder, frame.size, 1.0);
+    clouds.encode_clouds(&ctx, &mut encoder, &depth, None, None);
+    let scene = Scene::default();
+    let color = host_colour(&ctx, frame.size);
+    let background = cloudscape::post::Background {
+        color: &color,
+        depth: &depth,
+    };
+    clouds.encode_finish(&ctx, &mut encoder, &scene, &background, None);
+    ctx.queue.submit([encoder.finish()]);
+    // Asking does not wait: the answer is this frame's counters or none yet.
+    let early = clouds.stats(&ctx);
+    ctx.wait_idle();
+    let late = clouds.stats(&ctx).expect("the finished frame's counters");
+    assert_eq!(late.pixels, frame.size.x * frame.size.y);
+    assert!(late.density_samples_per_pixel > 1.0);
+    assert!(early.is_none_or(|s| s == late));
+}
+
+/// A colour target the compositor may read (never shown: the depth holds no geometry).
+fn host_colour(ctx: &GpuContext, size: UVec2) -> wgpu::TextureView {
+    use wgpu::TextureUsages as U;
+    let format = wgpu::TextureFormat::Rgba16Float;
+    cloudscape::gpu::pipeline::texture_2d(ctx, "host colour", size, format, U::TEXTURE_BINDING)
+        .create_view(&Default::default())
 }

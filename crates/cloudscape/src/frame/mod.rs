@@ -10,7 +10,7 @@ mod shared;
 
 pub use depth::DepthConvention;
 pub use gpu::{FrameGpu, FrameUniform};
-pub use shared::Shared;
+pub use shared::{Shared, SharedSlots};
 
 use crate::optics::PhaseLobes;
 use crate::output::SampleGrid;

@@ -5,6 +5,24 @@ use super::FrameGpu;
 use crate::environment::EnvironmentGpu;
 use crate::field::gpu::FieldGpu;
 
+/// Which shared groups a program uses: a pass binds only those (an unused slot stays empty).
+/// Binding no more than a program reads is also what lavapipe needs: it crashes when a compute pass
+/// binds the field's group and samples a texture of a higher group.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SharedSlots {
+    used: [bool; 3],
+}
+
+impl SharedSlots {
+    /// The shared groups program `root` ([`crate::shader::program`]) reaches.
+    pub fn of(root: &str) -> SharedSlots {
+        let modules = crate::shader::reached(root);
+        SharedSlots {
+            used: ["field", "frame", "environment"].map(|m| modules.contains(&m)),
+        }
+    }
+}
+
 /// The field, frame and environment groups of one frame, borrowed for encoding.
 #[derive(Clone, Copy)]
 pub struct Shared<'a> {
@@ -17,25 +35,33 @@ pub struct Shared<'a> {
 }
 
 impl<'a> Shared<'a> {
-    /// Pipeline layouts: the shared groups, then the pass's own at [`crate::shader::PASS_GROUP`].
+    /// Pipeline layouts: the shared groups `slots` names, then the pass's own at
+    /// [`crate::shader::PASS_GROUP`].
     pub fn layouts(
         &self,
+        slots: SharedSlots,
         pass: &'a wgpu::BindGroupLayout,
     ) -> [Option<&'a wgpu::BindGroupLayout>; 4] {
+        let [field, frame, environment] = slots.used;
         [
-            Some(self.field.layout()),
-            Some(self.frame.layout()),
-            Some(self.environment.layout()),
+            field.then_some(self.field.layout()),
+            frame.then_some(self.frame.layout()),
+            environment.then_some(self.environment.layout()),
             Some(pass),
         ]
     }
 
     /// Bind groups in the order of [`Shared::layouts`].
-    pub fn bind_groups(&self, pass: &'a wgpu::BindGroup) -> [Option<&'a wgpu::BindGroup>; 4] {
+    pub fn bind_groups(
+        &self,
+        slots: SharedSlots,
+        pass: &'a wgpu::BindGroup,
+    ) -> [Option<&'a wgpu::BindGroup>; 4] {
+        let [field, frame, environment] = slots.used;
         [
-            Some(self.field.bind_group()),
-            Some(self.frame.bind_group()),
-            Some(self.environment.bind_group()),
+            field.then_some(self.field.bind_group()),
+            frame.then_some(self.frame.bind_group()),
+            environment.then_some(self.environment.bind_group()),
             Some(pass),
         ]
     }

@@ -21,7 +21,9 @@ struct Slot {
 pub struct LateReadback {
     slots: Vec<Slot>,
     frames: u64,
-    latest: Option<Vec<u8>>,
+    /// The newest finished copy (allocated once, at the first).
+    latest: Vec<u8>,
+    has_latest: bool,
 }
 
 impl LateReadback {
@@ -42,7 +44,8 @@ impl LateReadback {
         LateReadback {
             slots,
             frames: 0,
-            latest: None,
+            latest: Vec::new(),
+            has_latest: false,
         }
     }
 
@@ -75,12 +78,14 @@ impl LateReadback {
             if frame > newest {
                 newest = frame;
                 if let Ok(view) = slot.buffer.slice(..).get_mapped_range() {
-                    self.latest = Some(view.to_vec());
+                    self.latest.clear();
+                    self.latest.extend_from_slice(&view);
+                    self.has_latest = true;
                 }
             }
             slot.buffer.unmap();
             slot.frame = None;
         }
-        self.latest.as_deref()
+        self.has_latest.then_some(self.latest.as_slice())
     }
 }

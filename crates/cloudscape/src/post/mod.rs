@@ -5,7 +5,7 @@
 
 pub mod tonemap;
 
-use crate::frame::Shared;
+use crate::frame::{Shared, SharedSlots};
 use crate::gpu::pipeline::{
     BindGroupCache, UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d,
     float_texture, storage_texture_2d, uniform_buffer,
@@ -39,6 +39,7 @@ pub struct Background<'a> {
 
 /// Composes a full-resolution cloud output over the background: `background * a + hazed rgb`.
 pub struct Compositor {
+    slots: SharedSlots,
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     group: BindGroupCache,
@@ -64,9 +65,10 @@ impl Compositor {
             "compose",
             &crate::shader::program("compose"),
             "compose_clouds_over_background",
-            &shared.layouts(&layout),
+            &shared.layouts(SharedSlots::of("compose"), &layout),
         );
         Compositor {
+            slots: SharedSlots::of("compose"),
             pipeline,
             layout,
             group: BindGroupCache::default(),
@@ -100,7 +102,7 @@ impl Compositor {
             encoder,
             "compose",
             &self.pipeline,
-            &shared.bind_groups(group),
+            &shared.bind_groups(self.slots, group),
             clouds.size,
             writes,
         );

@@ -1,7 +1,7 @@
 //! GPU probes: every WGSL function with a CPU twin, evaluated at given inputs, so tests hold the
 //! GPU against the CPU specification.
 
-use crate::frame::Shared;
+use crate::frame::{Shared, SharedSlots};
 use crate::gpu::pipeline::{
     UNIFORM, bind_group, bind_group_layout, compute_pipeline, storage_binding, storage_buffer,
 };
@@ -56,6 +56,7 @@ pub struct ProbeInput {
 
 /// The probe pipeline, built against the shared groups.
 pub struct Probe {
+    slots: SharedSlots,
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
 }
@@ -73,9 +74,13 @@ impl Probe {
             "probe",
             &crate::shader::program("probe"),
             "probe_functions",
-            &shared.layouts(&layout),
+            &shared.layouts(SharedSlots::of("probe"), &layout),
         );
-        Probe { pipeline, layout }
+        Probe {
+            slots: SharedSlots::of("probe"),
+            pipeline,
+            layout,
+        }
     }
 
     /// `function` at every input, as the GPU computes it with the shared groups' current contents
@@ -119,8 +124,10 @@ impl Probe {
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             pass.set_pipeline(&self.pipeline);
-            for (slot, g) in shared.bind_groups(&group).iter().enumerate() {
-                pass.set_bind_group(slot as u32, *g, &[]);
+            for (slot, g) in shared.bind_groups(self.slots, &group).iter().enumerate() {
+                if let Some(g) = g {
+                    pass.set_bind_group(slot as u32, *g, &[]);
+                }
             }
             pass.dispatch_workgroups(inputs.len().div_ceil(64) as u32, 1, 1);
         }

@@ -2,7 +2,7 @@
 //! that writes, per output texel, the radiance the clouds scatter toward the eye, the transmittance
 //! through them and the cloud distance ([`crate::output`]), stopping at the host's depth buffer.
 
-use crate::frame::Shared;
+use crate::frame::{Shared, SharedSlots};
 use crate::gpu::GpuContext;
 use crate::gpu::PassTimer;
 use crate::gpu::late_readback::LateReadback;
@@ -133,6 +133,7 @@ const STATS_BYTES: u64 = 8;
 
 /// The ray marcher: one compute pass, made once.
 pub struct RaymarchRenderer {
+    slots: SharedSlots,
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     march: wgpu::Buffer,
@@ -169,9 +170,10 @@ impl RaymarchRenderer {
             "raymarch",
             &crate::shader::program("raymarch"),
             "march_clouds",
-            &shared.layouts(&layout),
+            &shared.layouts(SharedSlots::of("raymarch"), &layout),
         );
         RaymarchRenderer {
+            slots: SharedSlots::of("raymarch"),
             pipeline,
             layout,
             march: uniform_buffer(ctx, "raymarch settings", size_of::<MarchUniform>() as u64),
@@ -254,7 +256,7 @@ impl Technique for RaymarchRenderer {
             encoder,
             "raymarch",
             &self.pipeline,
-            &shared.bind_groups(group),
+            &shared.bind_groups(self.slots, group),
             (size, self.settings.samples_per_pixel),
             writes,
         );

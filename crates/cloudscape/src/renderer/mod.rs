@@ -36,6 +36,7 @@ pub struct Rendered {
 /// An offline host's empty scene: a depth buffer with no geometry and a colour never shown.
 struct EmptyHost {
     size: UVec2,
+    convention: crate::frame::DepthConvention,
     depth: wgpu::TextureView,
     color: wgpu::TextureView,
 }
@@ -63,7 +64,12 @@ impl EmptyHost {
             ..Default::default()
         });
         ctx.queue.submit([encoder.finish()]);
-        EmptyHost { size, depth, color }
+        EmptyHost {
+            size,
+            convention: frame.depth,
+            depth,
+            color,
+        }
     }
 
     fn background(&self) -> Background<'_> {
@@ -111,7 +117,11 @@ impl SceneRenderer {
     }
 
     fn host(&mut self, ctx: &GpuContext, frame: &Frame) -> &EmptyHost {
-        if self.host.as_ref().is_none_or(|h| h.size != frame.size) {
+        if self
+            .host
+            .as_ref()
+            .is_none_or(|h| h.size != frame.size || h.convention != frame.depth)
+        {
             self.host = Some(EmptyHost::new(ctx, frame.size, frame));
         }
         self.host.as_ref().expect("the host was just made")

@@ -4,7 +4,7 @@
 //! upsamples them with depth awareness, reprojects the history at the cloud distance, clips it to
 //! the neighbourhood and blends. It reads only the cloud output ([`crate::output`]).
 
-use crate::frame::{Frame, Shared};
+use crate::frame::{Frame, Shared, SharedSlots};
 use crate::gpu::pipeline::{
     BindGroupCache, UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d,
     float_texture, storage_texture_2d, uniform_buffer,
@@ -113,13 +113,14 @@ struct PreviousFrame {
 /// The temporal resolve pass and its two full-resolution histories (ping-pong), each with the
 /// cloud distance its pixels show.
 pub struct TemporalResolve {
+    slots: SharedSlots,
     settings: TemporalSettings,
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
     sampler: wgpu::Sampler,
     history: Option<[CloudOutput; 2]>,
-    groups: [BindGroupCache; 2],
+    groups: BindGroupCache,
     previous: Option<PreviousFrame>,
     latest: usize,
 }
@@ -151,7 +152,7 @@ impl TemporalResolve {
             "temporal resolve",
             &crate::shader::program("temporal"),
             "resolve_clouds",
-            &shared.layouts(&layout),
+            &shared.layouts(SharedSlots::of("temporal"), &layout),
         );
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             mag_filter: wgpu::FilterMode::Linear,
@@ -159,6 +160,7 @@ impl TemporalResolve {
             ..Default::default()
         });
         TemporalResolve {
+            slots: SharedSlots::of("temporal"),
             settings,
             pipeline,
             layout,
@@ -223,7 +225,7 @@ impl TemporalResolve {
             &history[read].distance,
             &history[write].distance,
         ];
-        let group = self.groups[write].get(&views, || {
+        let group = self.groups.get(&views, || {
             use wgpu::BindingResource::{Sampler, TextureView};
             bind_group(
                 &ctx.device,
@@ -246,7 +248,7 @@ impl TemporalResolve {
             encoder,
             "temporal resolve",
             &self.pipeline,
-            &shared.bind_groups(group),
+            &shared.bind_groups(self.slots, group),
             frame.size,
             writes,
         );

@@ -17,8 +17,7 @@ struct Temporal {
 }
 
 @group(3) @binding(0) var<uniform> temporal: Temporal;
-@group(3) @binding(1) var current_clouds: texture_2d<f32>;
-@group(3) @binding(2) var current_distance: texture_2d<f32>;
+// Bindings 1 and 2: this frame's coarse output (coarse_clouds, coarse_distance in upsample.wgsl).
 @group(3) @binding(3) var history_in: texture_2d<f32>;
 @group(3) @binding(4) var history_linear: sampler;
 @group(3) @binding(5) var temporal_host_depth: texture_2d<f32>;
@@ -87,22 +86,22 @@ fn resolve_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     let divisor = frame.grid_divisor;
     let pixel = vec2<f32>(id.xy) + 0.5;
     let host_m = frame_depth_distance(pixel, textureLoad(temporal_host_depth, vec2<i32>(id.xy), 0).x);
-    let estimate = upsample_cloud(current_clouds, current_distance, id.xy, host_m);
+    let estimate = upsample_cloud(id.xy, host_m);
     var current = estimate.radiance_transmittance;
     var cloud_m = estimate.distance_m;
     // The pixel this frame's ray went through has a sample of its own.
     let own = vec2<i32>(id.xy / divisor);
     let fresh = all(id.xy % divisor == frame.grid_subpixel);
     if fresh {
-        current = textureLoad(current_clouds, own, 0);
-        cloud_m = textureLoad(current_distance, own, 0).x;
+        current = textureLoad(coarse_clouds, own, 0);
+        cloud_m = textureLoad(coarse_distance, own, 0).x;
     }
     // Neighbourhood statistics of the current grid: the spread sigma of the seed's ClipAABB.
     var m1 = vec4<f32>(0.0);
     var m2 = vec4<f32>(0.0);
     for (var y = -1; y <= 1; y++) {
         for (var x = -1; x <= 1; x++) {
-            let v = textureLoad(current_clouds, upsample_grid_texel(current_clouds, own + vec2<i32>(x, y)), 0);
+            let v = textureLoad(coarse_clouds, upsample_grid_texel(own + vec2<i32>(x, y)), 0);
             m1 += v;
             m2 += v * v;
         }

@@ -3,21 +3,28 @@
 // pass code that turns an output on a 1/divisor grid into full-resolution estimates, for any
 // technique.
 
+// The coarse cloud output a pass upsamples: bindings 1 and 2 of its own group (3), so that every
+// pass that reads a coarse output binds it alike. Globals, not function arguments: lavapipe crashes
+// on texture handles passed to functions.
+@group(3) @binding(1) var coarse_clouds: texture_2d<f32>;
+@group(3) @binding(2) var coarse_distance: texture_2d<f32>;
+
 struct UpsampledCloud {
     radiance_transmittance: vec4<f32>,
     distance_m: f32,
 }
 
-fn upsample_grid_texel(grid: texture_2d<f32>, texel: vec2<i32>) -> vec2<i32> {
-    return clamp(texel, vec2<i32>(0), vec2<i32>(textureDimensions(grid)) - 1);
+// `texel` clamped to the coarse output.
+fn upsample_grid_texel(texel: vec2<i32>) -> vec2<i32> {
+    return clamp(texel, vec2<i32>(0), vec2<i32>(textureDimensions(coarse_clouds)) - 1);
 }
 
-// The estimate at full-resolution pixel `px` from the grid output (`radiance`, `distance`):
+// The estimate at full-resolution pixel `px` from the coarse output:
 // bilinear weights over the four nearest grid samples, zeroed where a sample's cloud lies behind
 // this pixel's host geometry (`host_m` away). The cloud's distance averages over the samples that
 // see cloud, by how much they see: a clear sample (distance 0) would pull an edge's distance
 // halfway to the camera.
-fn upsample_cloud(radiance: texture_2d<f32>, distance: texture_2d<f32>, px: vec2<u32>, host_m: f32) -> UpsampledCloud {
+fn upsample_cloud(px: vec2<u32>, host_m: f32) -> UpsampledCloud {
     let pos = (vec2<f32>(px) + 0.5) / f32(frame.grid_divisor) - 0.5;
     let base = floor(pos);
     let f = pos - base;
@@ -27,11 +34,11 @@ fn upsample_cloud(radiance: texture_2d<f32>, distance: texture_2d<f32>, px: vec2
     var cloud_weight = 0.0;
     for (var k = 0; k < 4; k++) {
         let offset = vec2<i32>(k & 1, k >> 1u);
-        let texel = upsample_grid_texel(radiance, vec2<i32>(base) + offset);
+        let texel = upsample_grid_texel(vec2<i32>(base) + offset);
         let w2 = select(1.0 - f, f, vec2<bool>(offset == vec2<i32>(1)));
-        let depth_m = textureLoad(distance, texel, 0).x;
+        let depth_m = textureLoad(coarse_distance, texel, 0).x;
         let w = w2.x * w2.y * select(1.0, 0.0, depth_m > host_m) + 1.0e-6;
-        let sample = textureLoad(radiance, texel, 0);
+        let sample = textureLoad(coarse_clouds, texel, 0);
         value += sample * w;
         weight += w;
         cloud_m += depth_m * w * (1.0 - sample.a);

@@ -1,0 +1,29 @@
+//! The README's "Using the library" code is the example host's, line for line, so it compiles and
+//! runs in CI and cannot go stale.
+
+use std::path::Path;
+
+#[test]
+fn the_readme_shows_the_example_host() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(dir.join("../../README.md")).expect("README.md");
+    let example = std::fs::read_to_string(dir.join("examples/host.rs")).expect("examples/host.rs");
+    let section = &readme[readme.find("## Using the library").expect("the section")..];
+    let start = section.find("```rust\n").expect("a rust block") + "```rust\n".len();
+    let block = &section[start..start + section[start..].find("```").expect("closed block")];
+    let lines: Vec<&str> = block
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    assert!(
+        lines.len() >= 8,
+        "the snippet shows the host's frame: {lines:?}"
+    );
+    for line in lines {
+        assert!(
+            example.contains(line),
+            "README line not in examples/host.rs: {line}"
+        );
+    }
+}
