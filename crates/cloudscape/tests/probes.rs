@@ -1,12 +1,12 @@
 //! Every WGSL function with a CPU twin agrees with it on the GPU: the coarse field the light paths
 //! use, camera rays and depth in every convention, aerial perspective, the sun disc, the sky, the
-//! ground, the diffuse transmittance and tone mapping. Also: a live edit of the field reaches the
+//! ground, the diffuse transmittance, phase functions, height profiles and tone mapping. Also: a live edit of the field reaches the
 //! GPU without regenerating the noise.
 
 use cloudscape::environment::Environment;
 use cloudscape::frame::{DepthConvention, Frame};
 use cloudscape::gpu::GpuContext;
-use cloudscape::optics::diffuse_transmittance;
+use cloudscape::optics::{PhaseLobes, diffuse_transmittance};
 use cloudscape::post::tonemap;
 use cloudscape::probe::{Probe, ProbeFunction, ProbeInput};
 use cloudscape::renderer::{CloudRenderer, Reuse};
@@ -317,6 +317,53 @@ fn tone_mapping_matches_the_cpu() {
         let want: Vec<Vec4> = colours.iter().map(|c| cpu(*c).extend(0.0)).collect();
         assert_close(&format!("{function:?}"), &got, &want, 2e-4);
     }
+}
+
+#[test]
+fn phase_functions_and_height_profiles_match_the_cpu() {
+    let ctx = GpuContext::for_tests();
+    let scene = Scene::default();
+    let clouds = renderer(&ctx, &scene, &Frame::from_scene(&scene, SIZE));
+    let lobes = [
+        PhaseLobes::approximate_mie(20.0),
+        PhaseLobes::henyey_greenstein(0.85),
+        PhaseLobes::dual_henyey_greenstein(0.8, -0.3, 0.9),
+    ];
+    for phase in lobes {
+        let cases: Vec<(f32, f32)> = (0..200)
+            .map(|i| (2.0 * unit(i, 22) - 1.0, [1.0, 0.7, 0.49][i as usize % 3]))
+            .chain([(1.0, 1.0), (-1.0, 1.0)])
+            .collect();
+        let inputs: Vec<ProbeInput> = cases
+            .iter()
+            .map(|(mu, factor)| {
+                input(
+                    Vec4::from_array(phase.to_gpu()),
+                    Vec4::new(*mu, *factor, 0.0, 0.0),
+                )
+            })
+            .collect();
+        let got = gpu(&ctx, &clouds, ProbeFunction::Phase, &inputs);
+        let want: Vec<Vec4> = cases
+            .iter()
+            .map(|(mu, factor)| Vec4::splat(phase.scaled_anisotropy(*factor).eval(*mu)))
+            .collect();
+        assert_close(&format!("{phase:?}"), &got, &want, 1e-4);
+    }
+    let cases: Vec<ProbeInput> = (0..300)
+        .map(|i| {
+            input(
+                Vec4::new(3.2 * unit(i, 23) - 0.1, 1.1 * unit(i, 24) - 0.05, 0.0, 0.0),
+                Vec4::ZERO,
+            )
+        })
+        .collect();
+    let got = gpu(&ctx, &clouds, ProbeFunction::HeightGradient, &cases);
+    let want: Vec<Vec4> = cases
+        .iter()
+        .map(|c| Vec4::splat(cloudscape::field::profile::height_gradient(c.a.x, c.a.y)))
+        .collect();
+    assert_close("height gradient", &got, &want, 1e-5);
 }
 
 #[test]

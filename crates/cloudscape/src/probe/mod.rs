@@ -40,8 +40,13 @@ pub enum ProbeFunction {
     ToneMapAgx = 10,
     /// `linear_to_srgb(a.xyz)`: `tonemap::linear_to_srgb`.
     LinearToSrgb = 11,
-    /// `frame_diffuse_transmittance(a.x)`.
+    /// `frame_diffuse_transmittance(a.x)`: `optics::diffuse_transmittance`.
     DiffuseTransmittance = 12,
+    /// `phase_eval(phase_scaled(lobes a, factor b.y), cos theta b.x)`:
+    /// `PhaseLobes::scaled_anisotropy(factor).eval(cos theta)`.
+    Phase = 13,
+    /// `field_height_gradient(type a.x, height fraction a.y)`: `profile::height_gradient`.
+    HeightGradient = 14,
 }
 
 /// The inputs of one evaluation.

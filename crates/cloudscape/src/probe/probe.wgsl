@@ -1,4 +1,4 @@
-#import hiheight frame environment tonemap
+#import hiheight frame environment tonemap phase
 // Evaluates one WGSL function that has a CPU twin at given inputs, so tests can hold the GPU
 // against the specification (probe/mod.rs lists the functions and their twins).
 
@@ -30,6 +30,8 @@ fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
         case 10u: { return vec4<f32>(tonemap_agx(a.xyz), 0.0); }
         case 11u: { return vec4<f32>(linear_to_srgb(a.xyz), 0.0); }
         case 12u: { return vec4<f32>(frame_diffuse_transmittance(a.x)); }
+        case 13u: { return vec4<f32>(phase_eval(phase_scaled(a, b.y), b.x)); }
+        case 14u: { return vec4<f32>(field_height_gradient(a.x, a.y)); }
         default: { return vec4<f32>(-1.0); }
     }
 }
