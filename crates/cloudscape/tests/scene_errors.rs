@@ -252,3 +252,16 @@ fn the_embedded_default_is_the_default_scene() {
     assert_eq!(error.origin, "<default scene>");
     assert!(error.line.is_some());
 }
+
+#[test]
+fn a_technique_not_built_yet_is_located_and_lists_the_built_ones() {
+    for name in ["particles", "sprites"] {
+        let error = rejected(
+            &format!("[render]\ntechnique = \"{name}\"\n"),
+            2,
+            13,
+            "render.technique",
+        );
+        assert_mentions(&error, &[name, "not built yet", "built: raymarch"]);
+    }
+}
