@@ -9,7 +9,7 @@ use cloudscape::animation::{GifPreview, scene_at, time_range_s};
 use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, PassTimer};
 use cloudscape::image::LdrImage;
-use cloudscape::renderer::{PASSES, Rendered, Reuse, SceneRenderer};
+use cloudscape::renderer::{PASS_COUNT, Rendered, Reuse, SceneRenderer};
 use cloudscape::scene::{CloudLayer, Scene, SceneDocument};
 use ffmpeg::Mp4Writer;
 use glam::UVec2;
@@ -200,8 +200,7 @@ impl<'a> FrameRenderer<'a> {
             ctx,
             doc,
             renderer: None,
-            temporal: temporal
-                .map(|d| (temporal_reuse(d), PassTimer::new(ctx, PASSES.len() as u32))),
+            temporal: temporal.map(|d| (temporal_reuse(d), PassTimer::new(ctx, PASS_COUNT))),
             rebuilds: 0,
         }
     }

@@ -36,19 +36,7 @@ fn depth_buffer(
         U::TEXTURE_BINDING | U::RENDER_ATTACHMENT,
     );
     let view = depth_texture.create_view(&Default::default());
-    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("host geometry"),
-        color_attachments: &[],
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: &view,
-            depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(depth),
-                store: wgpu::StoreOp::Store,
-            }),
-            stencil_ops: None,
-        }),
-        ..Default::default()
-    });
+    cloudscape::gpu::pipeline::clear_depth(encoder, &view, depth);
     view
 }
 

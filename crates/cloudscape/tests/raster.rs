@@ -60,19 +60,7 @@ fn splats_blend_premultiplied_and_respect_a_read_only_depth_buffer() {
         &[],
     );
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("host depth at 0.5"),
-        color_attachments: &[],
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: &depth_view,
-            depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(0.5),
-                store: wgpu::StoreOp::Store,
-            }),
-            stencil_ops: None,
-        }),
-        ..Default::default()
-    });
+    cloudscape::gpu::pipeline::clear_depth(&mut encoder, &depth_view, 0.5);
     let mut timer = PassTimer::new(&ctx, 1);
     {
         let blue = wgpu::LoadOp::Clear(wgpu::Color::BLUE);

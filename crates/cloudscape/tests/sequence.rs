@@ -7,7 +7,7 @@
 use cloudscape::animation::scene_at;
 use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, PassTimer};
-use cloudscape::renderer::{PASSES, Reuse, SceneRenderer};
+use cloudscape::renderer::{PASS_COUNT, Reuse, SceneRenderer};
 use cloudscape::scene::SceneDocument;
 use cloudscape::temporal::TemporalSettings;
 use glam::UVec2;
@@ -40,7 +40,7 @@ fn temporal_frames_of_the_flythrough_match_their_goldens() {
     let ctx = GpuContext::for_tests();
     let mut renderer =
         SceneRenderer::new(&ctx, &doc.scene, &doc.resolve_path("")).expect("field builds");
-    let mut timer = PassTimer::new(&ctx, PASSES.len() as u32);
+    let mut timer = PassTimer::new(&ctx, PASS_COUNT);
     let reuse = Reuse::Temporal(TemporalSettings {
         divisor: 4,
         ..TemporalSettings::default()

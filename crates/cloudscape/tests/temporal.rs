@@ -4,7 +4,7 @@
 use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, PassTimer};
 use cloudscape::image::{LdrImage, flip};
-use cloudscape::renderer::{PASSES, Reuse, SceneRenderer};
+use cloudscape::renderer::{PASS_COUNT, Reuse, SceneRenderer};
 use cloudscape::scene::{Scene, SceneDocument};
 use cloudscape::temporal::TemporalSettings;
 use glam::{UVec2, Vec3};
@@ -31,7 +31,7 @@ fn converged(ctx: &GpuContext, scene: &Scene, frame: &Frame) -> LdrImage {
     still.render.samples_per_pixel = Some(8);
     still.render.primary_steps = Some(128);
     let mut renderer = SceneRenderer::new(ctx, &still, Path::new(".")).expect("field");
-    let mut timer = PassTimer::new(ctx, PASSES.len() as u32);
+    let mut timer = PassTimer::new(ctx, PASS_COUNT);
     renderer.render_frame(ctx, &still, frame, Reuse::None, &mut timer);
     renderer.images(ctx).ldr
 }
@@ -47,7 +47,7 @@ impl Sequence {
     fn new(ctx: &GpuContext, scene: &Scene, divisor: u32) -> Sequence {
         Sequence {
             renderer: SceneRenderer::new(ctx, scene, Path::new(".")).expect("field"),
-            timer: PassTimer::new(ctx, PASSES.len() as u32),
+            timer: PassTimer::new(ctx, PASS_COUNT),
             reuse: Reuse::Temporal(TemporalSettings {
                 divisor,
                 ..TemporalSettings::default()

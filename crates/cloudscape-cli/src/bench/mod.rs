@@ -9,7 +9,7 @@ use anyhow::{Result, anyhow};
 use clap::Args;
 use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, PassTimer};
-use cloudscape::renderer::{PASSES, Reuse, SceneRenderer};
+use cloudscape::renderer::{PASS_COUNT, Reuse, SceneRenderer};
 use glam::UVec2;
 use serde::Serialize;
 
@@ -93,9 +93,10 @@ fn run_repeated(args: BenchArgs) -> Result<()> {
     let mut renderer = SceneRenderer::new(&ctx, scene, &doc.resolve_path(""))
         .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
     let mut frame = Frame::from_scene(scene, UVec2::new(scene.render.width, scene.render.height));
-    let mut timer = PassTimer::new(&ctx, PASSES.len() as u32);
+    let mut timer = PassTimer::new(&ctx, PASS_COUNT);
+    let names = renderer.pass_names();
     let reuse = args.temporal.map_or(Reuse::None, temporal_reuse);
-    let mut pass_ms: Vec<Vec<f64>> = vec![Vec::new(); PASSES.len()];
+    let mut pass_ms: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
     let mut wall_ms = Vec::new();
     for i in 0..args.warmup + frames {
         frame.frame_index = i;
@@ -105,7 +106,7 @@ fn run_repeated(args: BenchArgs) -> Result<()> {
         }
         wall_ms.push(wall.as_secs_f64() * 1e3);
         for (label, ms) in timer.read_ms(&ctx) {
-            if let Some(k) = PASSES.iter().position(|p| *p == label) {
+            if let Some(k) = names.iter().position(|p| *p == label) {
                 pass_ms[k].push(ms);
             }
         }
@@ -117,7 +118,7 @@ fn run_repeated(args: BenchArgs) -> Result<()> {
         frames,
         timestamps: ctx.has_timestamps(),
         software: is_software(&ctx),
-        passes: PASSES
+        passes: names
             .iter()
             .zip(pass_ms)
             .filter(|(_, s)| !s.is_empty())

@@ -293,6 +293,24 @@ pub fn begin_render_pass<'e>(
     })
 }
 
+/// Records the clearing of depth buffer `view` to `depth` (a host's empty depth: the convention's
+/// far value).
+pub fn clear_depth(encoder: &mut wgpu::CommandEncoder, view: &wgpu::TextureView, depth: f32) {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("clear depth"),
+        color_attachments: &[],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(depth),
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        ..Default::default()
+    });
+}
+
 /// Bind groups made once and remade only when the views they bind change (a resized target): no
 /// bind group is created per frame. Holds two, so a pass that alternates between ping-pong
 /// targets (temporal history) keeps both.

@@ -160,6 +160,17 @@ impl CloudRenderer {
         self.technique.name()
     }
 
+    /// The labels of a frame's passes as a [`PassTimer`] records them, in order: the technique's
+    /// name, "temporal resolve" (with temporal reuse), "compose", "display".
+    pub fn pass_names(&self) -> [&'static str; 4] {
+        [
+            self.technique.name(),
+            "temporal resolve",
+            "compose",
+            "display",
+        ]
+    }
+
     /// Starts a frame: uploads `frame`, the scene's environment, the field's time and the
     /// technique's settings, and picks this frame's sample grid. `frame.frame_index` must advance
     /// every frame when `reuse` is temporal.
@@ -229,7 +240,7 @@ impl CloudRenderer {
             host_depth,
             output: &t.output,
         };
-        let timer = timer.map(|t| (t, "technique"));
+        let timer = timer.map(|t| (t, self.technique.name()));
         self.technique
             .encode(ctx, encoder, &shared, &targets, region, timer);
     }

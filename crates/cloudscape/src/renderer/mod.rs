@@ -9,7 +9,7 @@ pub use host::{CloudRenderer, FrameImages, Reuse};
 
 use crate::field::{CloudField, FieldError};
 use crate::frame::Frame;
-use crate::gpu::pipeline::texture_2d;
+use crate::gpu::pipeline::{clear_depth, texture_2d};
 use crate::gpu::{GpuContext, PassTimer, readback};
 use crate::image::{HdrImage, LdrImage};
 use crate::post::{Background, HDR_FORMAT};
@@ -22,8 +22,9 @@ use std::time::{Duration, Instant};
 /// Rows of output texels rendered per submission when reporting progress.
 const TILE_ROWS: u32 = 32;
 
-/// Names of the GPU passes of one frame, in order, as [`PassTimer`] labels them.
-pub const PASSES: [&str; 4] = ["technique", "temporal resolve", "compose", "display"];
+/// GPU passes of one frame at most: the technique, the temporal resolve, compose and display
+/// ([`CloudRenderer::pass_names`]); a [`PassTimer`] of this capacity times them all.
+pub const PASS_COUNT: u32 = 4;
 
 /// The images of one render.
 pub struct Rendered {
@@ -50,19 +51,7 @@ impl EmptyHost {
         let color = texture_2d(ctx, "host colour", size, HDR_FORMAT, U::TEXTURE_BINDING)
             .create_view(&Default::default());
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("clear depth"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(frame.depth.far_value()),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        });
+        clear_depth(&mut encoder, &depth, frame.depth.far_value());
         ctx.queue.submit([encoder.finish()]);
         EmptyHost {
             size,
@@ -103,6 +92,11 @@ impl SceneRenderer {
     /// The CPU field this renderer draws (the specification the GPU follows).
     pub fn field(&self) -> &CloudField {
         self.clouds.field()
+    }
+
+    /// The labels of a frame's passes ([`CloudRenderer::pass_names`]).
+    pub fn pass_names(&self) -> [&'static str; 4] {
+        self.clouds.pass_names()
     }
 
     /// The renderer a real-time host would drive.

@@ -7,7 +7,7 @@ use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, PassTimer};
 use cloudscape::image::{LdrImage, flip};
 use cloudscape::raymarch::MarchSettings;
-use cloudscape::renderer::{PASSES, Reuse, SceneRenderer};
+use cloudscape::renderer::{PASS_COUNT, Reuse, SceneRenderer};
 use cloudscape::scene::Scene;
 use glam::UVec2;
 use serde::Serialize;
@@ -147,7 +147,7 @@ impl<'a> Measurer<'a> {
         Measurer {
             ctx,
             renderer,
-            timer: PassTimer::new(ctx, PASSES.len() as u32),
+            timer: PassTimer::new(ctx, PASS_COUNT),
             clock,
             temporal,
             reference,
