@@ -118,17 +118,21 @@ fn field_height_gradient(type_coord: f32, f: f32) -> f32 {
     let t = clamp(type_coord, 0.0, 3.0);
     let lo = min(u32(floor(t)), 2u);
     let w = t - f32(lo);
-    let g = TYPE_GRADIENTS[lo] * (1.0 - w) + TYPE_GRADIENTS[lo + 1u] * w;
+    // One local copy, indexed twice: indexing the constant itself with a runtime index makes naga
+    // materialise the whole array at each access.
+    var gradients = TYPE_GRADIENTS;
+    let g = gradients[lo] * (1.0 - w) + gradients[lo + 1u] * w;
     let rise = clamp(field_remap(f, g.x, g.y, 0.0, 1.0), 0.0, 1.0);
     let fall = clamp(field_remap(f, g.z, g.w, 1.0, 0.0), 0.0, 1.0);
     return rise * fall;
 }
 
-fn field_type_coord(layer: FieldLayer, channel: f32) -> f32 {
+// The type coordinate of layer `layer` at weather type channel `channel`: TypeTable::type_coord.
+fn field_type_coord(layer: u32, channel: f32) -> f32 {
     let e = TYPE_BLEND_HALF_WIDTH;
-    var t = layer.type_first;
+    var t = field.layers[layer].type_first;
     for (var i = 0u; i < 3u; i++) {
-        t += layer.type_steps[i] * smoothstep(layer.type_bounds[i] - e, layer.type_bounds[i] + e, channel);
+        t += field.layers[layer].type_steps[i] * smoothstep(field.layers[layer].type_bounds[i] - e, field.layers[layer].type_bounds[i] + e, channel);
     }
     return t;
 }
@@ -149,15 +153,17 @@ fn field_erode(density: f32, detail: vec4<f32>, f: f32, erosion: f32) -> f32 {
     return clamp(field_remap(density, modifier * erosion, 1.0, 0.0, 1.0), 0.0, 1.0);
 }
 
-fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32, eroded: bool) -> f32 {
-    let f = (h - layer.bottom_m) / layer.thickness_m;
+// Extinction of layer `layer` (an index: its members are read from the uniform where used rather
+// than copied, which the march feels) at p, altitude h: CloudField::layer_extinction.
+fn field_layer_extinction(layer: u32, p: vec3<f32>, h: f32, eroded: bool) -> f32 {
+    let f = (h - field.layers[layer].bottom_m) / field.layers[layer].thickness_m;
     if f < 0.0 || f > 1.0 {
         return 0.0;
     }
-    let wind = layer.wind_m_per_s * field.time_s;
+    let wind = field.layers[layer].wind_m_per_s * field.time_s;
     let xz = p.xz - wind;
-    let w = textureSampleLevel(field_weather_map, field_repeat_linear, xz / field.weather_extent_m + layer.weather_offset, 0.0);
-    let coverage = clamp(w.x + 2.0 * layer.coverage - 1.0, 0.0, 1.0);
+    let w = textureSampleLevel(field_weather_map, field_repeat_linear, xz / field.weather_extent_m + field.layers[layer].weather_offset, 0.0);
+    let coverage = clamp(w.x + 2.0 * field.layers[layer].coverage - 1.0, 0.0, 1.0);
     if coverage <= 0.0 {
         return 0.0;
     }
@@ -166,7 +172,7 @@ fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32, eroded: bool)
     if gradient <= 0.0 {
         return 0.0;
     }
-    let q = p - vec3<f32>(wind.x, 0.0, wind.y) + layer.noise_offset_m;
+    let q = p - vec3<f32>(wind.x, 0.0, wind.y) + field.layers[layer].noise_offset_m;
     let base = textureSampleLevel(field_base_noise, field_repeat_linear, q / field.base_noise_period_m, 0.0);
     let fbm = base.y * 0.625 + base.z * 0.25 + base.w * 0.125;
     let shaped = field_remap(base.x, fbm - 1.0, 1.0, 0.0, 1.0) * gradient;
@@ -175,12 +181,12 @@ fn field_layer_extinction(layer: FieldLayer, p: vec3<f32>, h: f32, eroded: bool)
         return 0.0;
     }
     if !eroded {
-        return min(covered, 1.0) * w.z * layer.extinction_per_m;
+        return min(covered, 1.0) * w.z * field.layers[layer].extinction_per_m;
     }
     let curl = textureSampleLevel(field_curl_noise, field_repeat_linear, q.xz / field.base_noise_period_m, 0.0);
     let swirl = (curl.xy * 2.0 - 1.0) * field.curl_displacement_m * (1.0 - f);
     let detail = textureSampleLevel(field_detail_noise, field_repeat_linear, (q + vec3<f32>(swirl.x, 0.0, swirl.y)) / field.detail_noise_period_m, 0.0);
-    return field_erode(covered, detail, f, field.detail_erosion) * w.z * layer.extinction_per_m;
+    return field_erode(covered, detail, f, field.detail_erosion) * w.z * field.layers[layer].extinction_per_m;
 }
 
 fn field_volume_extinction(v: FieldVolume, p: vec3<f32>) -> f32 {
@@ -197,7 +203,7 @@ fn field_extinction_detail(p: vec3<f32>, eroded: bool) -> f32 {
     let h = field_altitude_m(p);
     var sigma_t = 0.0;
     for (var i = 0u; i < field.layer_count; i++) {
-        sigma_t += field_layer_extinction(field.layers[i], p, h, eroded);
+        sigma_t += field_layer_extinction(i, p, h, eroded);
     }
     for (var i = 0u; i < field.volume_count; i++) {
         sigma_t += field_volume_extinction(field.volumes[i], p);

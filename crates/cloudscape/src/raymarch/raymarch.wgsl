@@ -68,7 +68,7 @@ fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
 // contributes half its mean radiance (isotropic estimate), dimmed by the diffuse transmittance of
 // the cloud between the point and the top (bottom) of the layer, its optical depth estimated from
 // one sample halfway.
-fn march_ambient(p: vec3<f32>, h: f32) -> vec3<f32> {
+fn march_ambient(p: vec3<f32>, h: f32, light: MarchLight) -> vec3<f32> {
     let up = field_up(p);
     var above = 500.0;
     var below = 500.0;
@@ -78,12 +78,28 @@ fn march_ambient(p: vec3<f32>, h: f32) -> vec3<f32> {
     }
     let tau_up = field_extinction_coarse(p + up * (0.5 * above)) * above;
     let tau_down = field_extinction_coarse(p - up * (0.5 * below)) * below;
-    var ground = environment_ground_radiance(frame.ground_albedo, p);
+    let from_above = light.sky_above * frame_diffuse_transmittance(tau_up);
+    let from_below = light.from_below * frame_diffuse_transmittance(tau_down);
+    return march.ambient_scale * 0.5 * (from_above + from_below);
+}
+
+// The light around one ray's clouds, from the environment interface: the sun's irradiance, the
+// sky's mean radiance from above and the radiance from below (the unshadowed ground, or the sky
+// below the horizon without one).
+struct MarchLight {
+    sun: vec3<f32>,
+    sky_above: vec3<f32>,
+    from_below: vec3<f32>,
+}
+
+// MarchLight at p. Looked up once per ray, where it enters the clouds: the environment varies
+// slowly over a cloud, and per-sample look-ups cost the march more than they change it.
+fn march_light(p: vec3<f32>) -> MarchLight {
+    var below = environment_ground_radiance(frame.ground_albedo, p);
     if frame.has_ground == 0u {
-        ground = environment.sky_horizon_radiance;
+        below = environment_sky_radiance(-field_up(p));
     }
-    let sky = environment_sky_mean_radiance_up(p);
-    return march.ambient_scale * 0.5 * (sky * frame_diffuse_transmittance(tau_up) + ground * frame_diffuse_transmittance(tau_down));
+    return MarchLight(environment_sun_irradiance(p), environment_sky_mean_radiance_up(p), below);
 }
 
 // Sun light scattered toward the eye per unit sigma_s and unit sun irradiance, with
@@ -149,6 +165,7 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
     var distance_weighted = 0.0;
     var samples = 0u;
     let empty_until = march_empty_until(o, d, t0, t1, volume);
+    let light = march_light(o + d * max(t0, empty_until));
     let first = march_first_stratum(t0, t1, n, empty_until);
     var t_start = march_stratum_t(t0, t1, f32(first) / f32(n));
     for (var i = first; i < n; i++) {
@@ -167,8 +184,8 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
         }
         let h = field_altitude_m(p);
         let tau_sun = march_sun_optical_depth(p, jitter);
-        let sun = march_sun_scattering(cos_theta, tau_sun) * environment_sun_irradiance(p);
-        let source = albedo * (sun + march_ambient(p, h));
+        let sun = march_sun_scattering(cos_theta, tau_sun) * light.sun;
+        let source = albedo * (sun + march_ambient(p, h, light));
         let step_transmittance = exp(-sigma_t * dt);
         radiance += transmittance * source * (1.0 - step_transmittance);
         distance_weighted += transmittance * (1.0 - step_transmittance) * distance(p, o);
