@@ -71,6 +71,14 @@ pub const UNIFORM: wgpu::BindingType = wgpu::BindingType::Buffer {
     min_binding_size: None,
 };
 
+/// An unfilterable 2D float texture binding: depth buffers read as values (GLSL cannot load from
+/// depth samplers) and R32Float, which GL cannot filter.
+pub const UNFILTERABLE_TEXTURE_2D: wgpu::BindingType = wgpu::BindingType::Texture {
+    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+    view_dimension: wgpu::TextureViewDimension::D2,
+    multisampled: false,
+};
+
 /// A filterable float texture binding of the given dimension.
 pub fn float_texture(dimension: wgpu::TextureViewDimension) -> wgpu::BindingType {
     wgpu::BindingType::Texture {

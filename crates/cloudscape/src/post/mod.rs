@@ -7,8 +7,8 @@ pub mod tonemap;
 
 use crate::frame::{Shared, SharedSlots};
 use crate::gpu::pipeline::{
-    BindGroupCache, UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d,
-    float_texture, storage_texture_2d, uniform_buffer,
+    BindGroupCache, UNFILTERABLE_TEXTURE_2D, UNIFORM, bind_group, bind_group_layout,
+    compute_pipeline, dispatch_2d, float_texture, storage_texture_2d, uniform_buffer,
 };
 use crate::gpu::{GpuContext, PassTimer};
 use crate::output::CloudOutput;
@@ -20,13 +20,6 @@ use glam::UVec2;
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Format of the display image (sRGB-encoded values in a unorm texture, storage-writable everywhere).
 pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
-
-/// An unfilterable 2D float texture binding (depth buffers, R32Float, which GL cannot filter).
-const UNFILTERABLE_2D: wgpu::BindingType = wgpu::BindingType::Texture {
-    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-    view_dimension: wgpu::TextureViewDimension::D2,
-    multisampled: false,
-};
 
 /// What lies behind the clouds: the host's colour and depth at full resolution. Where the depth
 /// holds geometry its colour is the background; elsewhere the sky, sun and ground are.
@@ -54,9 +47,9 @@ impl Compositor {
             "compose",
             &[
                 float_texture(d2),
-                UNFILTERABLE_2D,
-                UNFILTERABLE_2D,
-                UNFILTERABLE_2D,
+                UNFILTERABLE_TEXTURE_2D,
+                UNFILTERABLE_TEXTURE_2D,
+                UNFILTERABLE_TEXTURE_2D,
                 storage_texture_2d(HDR_FORMAT),
             ],
         );

@@ -7,8 +7,9 @@ use crate::gpu::GpuContext;
 use crate::gpu::PassTimer;
 use crate::gpu::late_readback::LateReadback;
 use crate::gpu::pipeline::{
-    BindGroupCache, UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d_repeated,
-    storage_binding, storage_buffer, storage_texture_2d, uniform_buffer,
+    BindGroupCache, UNFILTERABLE_TEXTURE_2D, UNIFORM, bind_group, bind_group_layout,
+    compute_pipeline, dispatch_2d_repeated, storage_binding, storage_buffer, storage_texture_2d,
+    uniform_buffer,
 };
 use crate::optics::PhaseLobes;
 use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
@@ -148,11 +149,7 @@ pub struct RaymarchRenderer {
 impl RaymarchRenderer {
     /// Builds the pipeline against the shared groups' layouts.
     pub fn new(ctx: &GpuContext, shared: &Shared) -> RaymarchRenderer {
-        let depth = wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        };
+        let depth = UNFILTERABLE_TEXTURE_2D;
         let layout = bind_group_layout(
             &ctx.device,
             "raymarch",

@@ -141,11 +141,6 @@ impl CloudRenderer {
         &self.field
     }
 
-    /// The field's GPU resources.
-    pub fn field_gpu(&self) -> &FieldGpu {
-        &self.field_gpu
-    }
-
     /// The shared groups, for passes a host adds (probes, its own effects).
     pub fn shared(&self) -> Shared<'_> {
         Shared {
@@ -204,17 +199,6 @@ impl CloudRenderer {
         self.technique.prepare(ctx, scene);
         self.frame = Some(frame.clone());
         self.reuse = reuse;
-    }
-
-    /// The size of this frame's cloud output (the technique's grid), in texels.
-    pub fn output_size(&self) -> UVec2 {
-        self.targets().output.size
-    }
-
-    fn targets(&self) -> &Targets {
-        self.targets
-            .as_ref()
-            .expect("begin_frame makes the targets")
     }
 
     /// Records the technique over output texels `region` (origin, size; None for all of them).
@@ -295,7 +279,10 @@ impl CloudRenderer {
 
     /// The images of the last frame encoded, valid once its work is submitted.
     pub fn images(&self) -> FrameImages<'_> {
-        let t = self.targets();
+        let t = self
+            .targets
+            .as_ref()
+            .expect("begin_frame makes the targets");
         let clouds = match (self.reuse, &self.temporal) {
             (Reuse::Temporal(_), Some(temporal)) => temporal.latest().unwrap_or(&t.output),
             _ => &t.output,

@@ -6,8 +6,8 @@
 
 use crate::frame::{Frame, Shared, SharedSlots};
 use crate::gpu::pipeline::{
-    BindGroupCache, UNIFORM, bind_group, bind_group_layout, compute_pipeline, dispatch_2d,
-    float_texture, storage_texture_2d, uniform_buffer,
+    BindGroupCache, UNFILTERABLE_TEXTURE_2D, UNIFORM, bind_group, bind_group_layout,
+    compute_pipeline, dispatch_2d, float_texture, storage_texture_2d, uniform_buffer,
 };
 use crate::gpu::{GpuContext, PassTimer};
 use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT, CloudOutput, SampleGrid};
@@ -129,11 +129,7 @@ impl TemporalResolve {
     /// Builds the pass against the shared groups' layouts.
     pub fn new(ctx: &GpuContext, shared: &Shared, settings: TemporalSettings) -> TemporalResolve {
         use wgpu::TextureViewDimension::D2;
-        let unfilterable = wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: D2,
-            multisampled: false,
-        };
+        let unfilterable = UNFILTERABLE_TEXTURE_2D;
         let sampler_type = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
         let types = [
             UNIFORM,
