@@ -1,6 +1,7 @@
 //! `cloudscape`: render, export and benchmark cloud scenes from the command line.
 
 mod animate;
+mod bake;
 mod bench;
 mod common;
 mod compare;
@@ -38,6 +39,9 @@ enum Command {
     /// Render a scene's frames over scene time (camera, sun and coverage paths, wind) to PNG or
     /// EXR files, with an animated GIF preview (and an MP4 when ffmpeg is on PATH).
     Animate(animate::AnimateArgs),
+    /// Bake the particle technique's look-up tables (optical depth on the GPU, single and multiple
+    /// scattering on the CPU) for a scene into the cache or `--out`, with timings and checks.
+    Bake(bake::BakeArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -50,6 +54,7 @@ fn main() -> std::process::ExitCode {
         Command::Compare(args) => compare::run(args),
         Command::Report(args) => report::run(args),
         Command::Animate(args) => animate::run(args),
+        Command::Bake(args) => bake::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

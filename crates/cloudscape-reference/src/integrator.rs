@@ -5,7 +5,8 @@
 //! then the sky and the sun disc are seen directly). At every scattering vertex:
 //!
 //! - the sun: one direction uniform over its disc, weighted by the phase function (or the
-//!   Lambertian BRDF on the ground) and by ratio-tracked transmittance;
+//!   Lambertian BRDF on the ground) and by ratio-tracked transmittance, combined by the power
+//!   heuristic with continuations that leave the medium through the disc;
 //! - the sky (in the medium): one direction from [`Environment::sample_sky`], combined with the
 //!   phase-sampled continuation by the power heuristic (Veach 1997, "Robust Monte Carlo Methods
 //!   for Light Transport Simulation", section 9.2); on the ground the cosine-sampled continuation
@@ -21,7 +22,7 @@
 //! what it sees. Here the primary vertex's radiance is blended by its distance, which is the same
 //! blend in expectation; light between vertices is not hazed (as on the GPU).
 
-use crate::environment::{Environment, GroundPoint};
+use crate::environment::{Environment, GroundPoint, SunDisc};
 use crate::medium::Medium;
 use crate::rng::Rng;
 use crate::tracking::TrackedMedium;
@@ -65,6 +66,9 @@ pub struct PathTracer<M> {
     pub environment: Environment,
     /// Camera (rays, far distance, image size).
     pub frame: Frame,
+    /// Scattering orders counted: light scattered more often is dropped (1 gives single
+    /// scattering); [`MAX_SCATTERING_EVENTS`] for the full transport.
+    pub max_scattering_orders: u32,
 }
 
 impl<M: Medium> PathTracer<M> {
@@ -105,13 +109,13 @@ impl<M: Medium> PathTracer<M> {
     fn path_radiance(&self, mut vertex: Vertex, rng: &mut Rng) -> Vec3 {
         let mut throughput = Vec3::ONE;
         let mut radiance = Vec3::ZERO;
-        for events in 0..MAX_SCATTERING_EVENTS {
+        for events in 0..self.max_scattering_orders.min(MAX_SCATTERING_EVENTS) {
             if matches!(vertex, Vertex::Medium { .. }) {
                 throughput *= self.albedo;
             }
             let guided = events < SUN_GUIDED_EVENTS;
-            radiance +=
-                throughput * (self.sun_light(vertex, rng) + self.sky_light(vertex, guided, rng));
+            radiance += throughput
+                * (self.sun_light(vertex, guided, rng) + self.sky_light(vertex, guided, rng));
             let next = self.continue_from(vertex, guided, rng);
             throughput *= next.weight;
             if !roulette(&mut throughput, rng) {
@@ -130,6 +134,7 @@ impl<M: Medium> PathTracer<M> {
                 None => {
                     let weight = power_heuristic(next.pdf, next.sky_pdf);
                     radiance += throughput * self.environment.sky_radiance(next.dir) * weight;
+                    radiance += throughput * self.sun_reached(next.dir, next.pdf);
                     break;
                 }
             };
@@ -145,21 +150,40 @@ impl<M: Medium> PathTracer<M> {
         self.volume.transmittance(origin, dir, f32::INFINITY, rng)
     }
 
-    /// Next-event estimate of the sun's light scattered at `vertex` toward the path.
-    fn sun_light(&self, vertex: Vertex, rng: &mut Rng) -> Vec3 {
+    /// Next-event estimate of the sun's light scattered at `vertex` toward the path, weighted
+    /// against the continuation's chance of reaching the disc by the power heuristic (the
+    /// continuation's share is [`Self::sun_reached`]). Without the weighting, a phase function
+    /// whose forward peak is narrower than the disc (cloud droplets' is about 0.3 degrees) turns
+    /// the rare vertices whose path points at the sun into fireflies.
+    fn sun_light(&self, vertex: Vertex, guided: bool, rng: &mut Rng) -> Vec3 {
         let Some(sun) = self.environment.sun else {
             return Vec3::ZERO;
         };
         let dir = crate::sampling::uniform_cone(sun.direction, sun.cos_radius, rng.next_vec2());
-        // Uniform over the disc: radiance E / Omega over density 1 / Omega leaves E.
-        let scattering = match vertex {
-            Vertex::Medium { dir: incoming, .. } => Vec3::splat(self.phase.eval(incoming.dot(dir))),
-            Vertex::Ground(g) => self.ground_brdf() * g.normal.dot(dir).max(0.0),
-        };
+        let (scattering, continuation_pdf) = self.scattering(vertex, guided, dir);
         if scattering.max_element() <= 0.0 {
             return Vec3::ZERO;
         }
-        sun.irradiance * scattering * self.visibility(position(vertex), dir, rng)
+        // Uniform over the disc: radiance E / Omega over density 1 / Omega leaves E.
+        let weight = match sun_disc_pdf(&sun) {
+            Some(pdf) => power_heuristic(pdf, continuation_pdf),
+            None => 1.0,
+        };
+        sun.irradiance * scattering * (weight * self.visibility(position(vertex), dir, rng))
+    }
+
+    /// The sun disc's radiance seen by a continuation that left the medium along `dir` (drawn
+    /// with density `pdf`), weighted against the sun's next-event estimate.
+    fn sun_reached(&self, dir: Vec3, pdf: f32) -> Vec3 {
+        let Some(sun) = self.environment.sun else {
+            return Vec3::ZERO;
+        };
+        match sun_disc_pdf(&sun) {
+            Some(light_pdf) if dir.dot(sun.direction) >= sun.cos_radius => {
+                sun.radiance(dir) * power_heuristic(pdf, light_pdf)
+            }
+            _ => Vec3::ZERO,
+        }
     }
 
     /// Next-event estimate of the sky's light scattered at a medium vertex, weighted against
@@ -281,6 +305,12 @@ fn position(vertex: Vertex) -> Vec3 {
         Vertex::Medium { position, .. } => position,
         Vertex::Ground(g) => g.position,
     }
+}
+
+/// Density of the sun's next-event directions (uniform over the disc), None for a point sun.
+fn sun_disc_pdf(sun: &SunDisc) -> Option<f32> {
+    let solid_angle = 2.0 * PI * (1.0 - sun.cos_radius);
+    (solid_angle > 0.0).then(|| 1.0 / solid_angle)
 }
 
 /// Power heuristic with exponent 2 (Veach 1997): the weight of a sample drawn with density `a`

@@ -45,6 +45,7 @@ impl PathTracer<CloudMedium> {
             albedo: scene.lighting.albedo,
             environment,
             frame,
+            max_scattering_orders: crate::integrator::MAX_SCATTERING_EVENTS,
         })
     }
 }

@@ -23,6 +23,7 @@ pub mod gpu;
 pub mod image;
 pub mod optics;
 pub mod output;
+pub mod particles;
 pub mod post;
 pub mod probe;
 pub mod raymarch;

@@ -43,6 +43,11 @@ pub const MODULES: &[WgslModule] = &[
     module("tonemap", include_str!("post/tonemap.wgsl")),
     module("display", include_str!("post/display.wgsl")),
     module("probe", include_str!("probe/probe.wgsl")),
+    module("particle", include_str!("particles/particle.wgsl")),
+    module(
+        "particle_bake",
+        include_str!("particles/particle_bake.wgsl"),
+    ),
 ];
 
 /// The modules with entry points: every pipeline the crate builds starts from one of these.
@@ -53,6 +58,7 @@ pub const PROGRAMS: &[&str] = &[
     "compose",
     "display",
     "probe",
+    "particle_bake",
 ];
 
 /// Bind group slots shared by every program: the field, the frame, the environment; each pass

@@ -6,6 +6,7 @@
 //! One test binary holds every command's tests, so they share [`support`].
 
 mod animate;
+mod bake;
 mod commands;
 mod reference;
 mod support;

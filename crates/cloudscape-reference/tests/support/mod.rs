@@ -56,6 +56,7 @@ pub fn tracer(
         albedo,
         environment,
         frame: Frame::from_scene(&Scene::default(), size),
+        max_scattering_orders: cloudscape_reference::integrator::MAX_SCATTERING_EVENTS,
     }
 }
 

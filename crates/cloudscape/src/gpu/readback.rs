@@ -6,7 +6,8 @@
 
 use super::GpuContext;
 
-/// The texels of mip level 0, layer 0 of a 2D `texture`, rows tightly packed (no row padding).
+/// The texels of mip level 0 of `texture`, every layer or depth slice, rows tightly packed (no
+/// row padding).
 ///
 /// Works for any colour format with a fixed block size (uncompressed or block-compressed); the
 /// texture needs [`wgpu::TextureUsages::COPY_SRC`]. wgpu requires each copied row to start on a
@@ -16,7 +17,11 @@ use super::GpuContext;
 /// For formats without a single block size (depth-stencil, multi-planar) and on device loss.
 pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture) -> Vec<u8> {
     let layout = RowLayout::of(texture);
-    let staging = staging_buffer(ctx, layout.padded_row_bytes * u64::from(layout.rows));
+    let slices = texture.size().depth_or_array_layers;
+    let staging = staging_buffer(
+        ctx,
+        layout.padded_row_bytes * u64::from(layout.rows) * u64::from(slices),
+    );
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     encoder.copy_texture_to_buffer(
         texture.as_image_copy(),
@@ -28,10 +33,7 @@ pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture) -> Vec<u8> {
                 rows_per_image: Some(layout.rows),
             },
         },
-        wgpu::Extent3d {
-            depth_or_array_layers: 1,
-            ..texture.size()
-        },
+        texture.size(),
     );
     ctx.queue.submit([encoder.finish()]);
     let padded = map_and_copy(ctx, &staging);

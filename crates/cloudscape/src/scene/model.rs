@@ -35,6 +35,8 @@ pub struct Scene {
     pub phase: PhaseFunction,
     /// Lighting approximations used by the real-time techniques.
     pub lighting: Lighting,
+    /// The reference particle of the particle technique, whose lighting is precomputed.
+    pub particles: Particles,
     /// Image size, technique, quality, exposure and output.
     pub render: RenderSettings,
     /// Keyframed camera, sun and coverage over scene time; empty (a static scene) by default.
@@ -56,6 +58,7 @@ impl Default for Scene {
             volumes: Vec::new(),
             phase: PhaseFunction::default(),
             lighting: Lighting::default(),
+            particles: Particles::default(),
             render: RenderSettings::default(),
             animation: Animation::default(),
         }
@@ -454,6 +457,67 @@ impl Default for Lighting {
             octave_contribution: 0.7,
             octave_eccentricity: 0.7,
             ambient_scale: 1.0,
+        }
+    }
+}
+
+/// How 3D noise shapes the reference particle (Yusov 2014, "Pre-computing optical depth: 3D noise
+/// generation").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ParticleStyle {
+    /// A smooth radial falloff whose density the noise modulates.
+    Smooth,
+    /// The noisy falloff thresholded: a denser core with crisp, lumpy edges.
+    Thresholded,
+    /// A sphere whose surface the noise displaces radially: billowing, cauliflower-like.
+    Pyroclastic,
+}
+
+impl ParticleStyle {
+    /// The index the shaders switch on (`PARTICLE_SMOOTH`, ... in `particle.wgsl`).
+    pub fn gpu_index(self) -> u32 {
+        match self {
+            ParticleStyle::Smooth => 0,
+            ParticleStyle::Thresholded => 1,
+            ParticleStyle::Pyroclastic => 2,
+        }
+    }
+}
+
+/// The reference particle of the particle technique (Yusov 2014): its lighting is precomputed
+/// once, for this particle, into look-up tables (`cloudscape bake`). Its peak extinction is the
+/// largest `extinction_per_m` of the layers (0.05 m^-1 without layers), its phase function and
+/// albedo those of the scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Particles {
+    /// How 3D noise shapes the particle.
+    pub style: ParticleStyle,
+    /// Radius of the reference particle, m, 10..5000 (Yusov's sample: 200 m).
+    pub radius_m: f32,
+    /// How finely the tables are sampled.
+    pub table_resolution: TableResolution,
+}
+
+/// How finely the particle tables are sampled (sizes in `particles::ParticleTableSpec`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TableResolution {
+    /// A quarter of the standard entries: quick previews and tests.
+    Low,
+    /// The seed's sizes.
+    Standard,
+    /// Four times the standard entries: stills, and fast GPUs.
+    High,
+}
+
+impl Default for Particles {
+    fn default() -> Self {
+        Particles {
+            style: ParticleStyle::Smooth,
+            radius_m: 200.0,
+            table_resolution: TableResolution::Standard,
         }
     }
 }

@@ -227,6 +227,7 @@ const SCENE_RULES: &[Rule<Scene>] = &[
     rule("lighting.octave_contribution", Between(0.0, 1.0), "", |s| Float(s.lighting.octave_contribution)),
     rule("lighting.octave_eccentricity", Between(0.0, 1.0), "", |s| Float(s.lighting.octave_eccentricity)),
     rule("lighting.ambient_scale", Between(0.0, 4.0), "", |s| Float(s.lighting.ambient_scale)),
+    rule("particles.radius_m", Between(10.0, 5000.0), "m", |s| Float(s.particles.radius_m)),
     rule("render.width", AtLeast(1.0), "px", |s| Int(s.render.width)),
     rule("render.height", AtLeast(1.0), "px", |s| Int(s.render.height)),
     rule("render.primary_steps", Between(1.0, 4096.0), "", |s| optional_int(s.render.primary_steps)),

@@ -1,0 +1,182 @@
+//! Precomputed lighting of volumetric particles (Yusov 2014, "Realistic Cloud Rendering Using
+//! Pixel Sync"): a reference particle whose optical depth and scattering are baked once into
+//! look-up tables, so that the particle technique shades each particle with a few texture reads.
+//!
+//! - [`density`]: the reference particle, a noisy radial falloff in three styles;
+//! - [`optical_depth`]: the 4D optical-depth table (CPU specification), [`gpu`] its GPU bake;
+//! - [`scattering`]: single and multiple scattering of the spherically symmetric particle, order by
+//!   order;
+//! - [`table_file`]: table files and their keys; [`store`]: the shipped tables and the cache.
+//!
+//! [`ParticleTableSpec`] gathers, from a scene, every input of the tables.
+
+pub mod density;
+pub mod gpu;
+pub mod optical_depth;
+pub mod scattering;
+pub mod store;
+pub mod table_file;
+
+use crate::optics::PhaseLobes;
+use crate::scene::{Scene, TableResolution};
+use density::{RadialProfile, ReferenceParticle};
+use optical_depth::OpticalDepthLayout;
+use scattering::{OrderGrid, ScatteringLayout, SymmetricParticle};
+
+/// Peak extinction of the reference particle without cloud layers, m^-1 (the layers' default).
+pub const DEFAULT_EXTINCTION_PER_M: f32 = 0.05;
+
+/// Every input of the particle tables.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParticleTableSpec {
+    /// The noisy particle (style and seed).
+    pub particle: ReferenceParticle,
+    /// Its radius, m.
+    pub radius_m: f32,
+    /// Its peak extinction, m^-1.
+    pub extinction_per_m: f32,
+    /// Single-scattering albedo.
+    pub albedo: f32,
+    /// Phase function.
+    pub phase: PhaseLobes,
+    /// Size of the optical-depth table.
+    pub optical_depth: OpticalDepthLayout,
+    /// Size of the scattering tables.
+    pub scattering: ScatteringLayout,
+    /// Resolution of the scattering orders.
+    pub orders: OrderGrid,
+}
+
+impl ParticleTableSpec {
+    /// The tables a scene needs, at the default sizes.
+    pub fn from_scene(scene: &Scene) -> ParticleTableSpec {
+        let extinction_per_m = scene
+            .layers
+            .iter()
+            .map(|l| l.extinction_per_m)
+            .reduce(f32::max)
+            .unwrap_or(DEFAULT_EXTINCTION_PER_M);
+        ParticleTableSpec {
+            particle: ReferenceParticle {
+                style: scene.particles.style,
+                seed: scene.noise.seed,
+            },
+            radius_m: scene.particles.radius_m,
+            extinction_per_m,
+            albedo: scene.lighting.albedo,
+            phase: PhaseLobes::from_scene(&scene.phase),
+            optical_depth: OpticalDepthLayout::at(scene.particles.table_resolution),
+            scattering: ScatteringLayout::at(scene.particles.table_resolution),
+            orders: OrderGrid::at(scene.particles.table_resolution),
+        }
+    }
+
+    /// The spherically symmetric particle of the scattering tables: the noisy particle's density
+    /// averaged over directions.
+    pub fn symmetric_particle(&self) -> SymmetricParticle {
+        SymmetricParticle {
+            profile: RadialProfile::of(&self.particle),
+            optical_radius: self.extinction_per_m * self.radius_m,
+            albedo: self.albedo,
+            phase: self.phase,
+        }
+    }
+
+    /// Key of the optical-depth table: its style, seed and size (it is in particle radii, so the
+    /// radius and extinction do not enter).
+    pub fn optical_depth_key(&self) -> u64 {
+        let l = self.optical_depth;
+        let mut h = table_file::KeyHasher::new("optical depth");
+        h.u32(self.particle.style.gpu_index());
+        h.u32(self.particle.seed);
+        for v in [l.start_zenith, l.start_azimuth, l.dir_zenith, l.dir_azimuth] {
+            h.u32(v);
+        }
+        h.finish()
+    }
+
+    /// Key of the scattering tables: everything the bake reads.
+    pub fn scattering_key(&self) -> u64 {
+        let mut h = table_file::KeyHasher::new("scattering");
+        h.u32(self.particle.style.gpu_index());
+        h.u32(self.particle.seed);
+        h.f32(self.radius_m * self.extinction_per_m);
+        h.f32(self.albedo);
+        for v in self.phase.to_gpu() {
+            h.f32(v);
+        }
+        let (s, o) = (self.scattering, self.orders);
+        for v in [s.entry, s.view_zenith, s.view_azimuth, o.radii, o.polar] {
+            h.u32(v);
+        }
+        for v in [
+            o.directions.zeniths,
+            o.directions.azimuths,
+            o.steps_per_radius,
+        ] {
+            h.u32(v);
+        }
+        h.finish()
+    }
+}
+
+impl OpticalDepthLayout {
+    /// The layout of a resolution: the standard one is the seed's, the others halve or double
+    /// the entry-point angles (the texture's depth, direction zeniths x azimuths, stays within
+    /// the 2048 every adapter supports).
+    pub fn at(resolution: TableResolution) -> OpticalDepthLayout {
+        let d = OpticalDepthLayout::DEFAULT;
+        match resolution {
+            TableResolution::Low => OpticalDepthLayout {
+                start_zenith: 16,
+                start_azimuth: 32,
+                dir_zenith: 16,
+                dir_azimuth: 32,
+            },
+            TableResolution::Standard => d,
+            TableResolution::High => OpticalDepthLayout {
+                start_zenith: 2 * d.start_zenith,
+                start_azimuth: 2 * d.start_azimuth,
+                ..d
+            },
+        }
+    }
+}
+
+impl ScatteringLayout {
+    /// The layout of a resolution: every axis halved or doubled from the default.
+    pub fn at(resolution: TableResolution) -> ScatteringLayout {
+        let d = ScatteringLayout::DEFAULT;
+        let scale = |f: fn(u32) -> u32| ScatteringLayout {
+            entry: f(d.entry),
+            view_zenith: f(d.view_zenith),
+            view_azimuth: f(d.view_azimuth),
+        };
+        match resolution {
+            TableResolution::Low => scale(|n| n / 2),
+            TableResolution::Standard => d,
+            TableResolution::High => scale(|n| n * 2),
+        }
+    }
+}
+
+impl OrderGrid {
+    /// The intermediate grid of a resolution: every axis halved or times 1.5 from the default.
+    pub fn at(resolution: TableResolution) -> OrderGrid {
+        let d = OrderGrid::DEFAULT;
+        let scale = |f: fn(u32) -> u32| OrderGrid {
+            radii: f(d.radii),
+            polar: f(d.polar),
+            directions: scattering::directions::DirectionGrid {
+                zeniths: f(d.directions.zeniths),
+                azimuths: f(d.directions.azimuths),
+            },
+            steps_per_radius: f(d.steps_per_radius),
+        };
+        match resolution {
+            TableResolution::Low => scale(|n| n / 2),
+            TableResolution::Standard => d,
+            TableResolution::High => scale(|n| n * 3 / 2),
+        }
+    }
+}
