@@ -32,6 +32,10 @@ pub struct BakeArgs {
     /// Repetitions of each bake with `--bench`.
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
     repeat: u32,
+    /// Write a PNG of the particle as the tables shade it, seen from the sun's side round to
+    /// against the sun (top row), and of the noisy particle's opacity (bottom row).
+    #[arg(long, value_name = "PATH.png")]
+    preview: Option<PathBuf>,
 }
 
 /// Bakes both tables, writes them and prints what they cost and how right they are.
@@ -57,7 +61,64 @@ pub fn run(args: BakeArgs) -> Result<()> {
         .write(&path)
         .with_context(|| format!("writing {}", path.display()))?;
     eprintln!("  wrote {}", path.display());
+    if let Some(preview) = &args.preview {
+        write_preview(preview, &doc.scene, &spec, &optical_depth, &scattering)?;
+        eprintln!("  wrote {}", preview.display());
+    }
     Ok(())
+}
+
+/// Angles between the eye's view and the sunlight's direction in the preview, degrees.
+const PREVIEW_ANGLES_DEG: [f32; 6] = [15.0, 60.0, 90.0, 125.0, 155.0, 170.0];
+/// Pixels per side of each view in the preview.
+const PREVIEW_PIXELS: u32 = 160;
+
+/// The preview PNG: per view angle, the scattered light (top, under the scene's sun, tone mapped
+/// as the scene says) and the optical mass through a differently rotated noisy particle (bottom,
+/// linear grey, white at the largest).
+fn write_preview(
+    path: &std::path::Path,
+    scene: &cloudscape::scene::Scene,
+    spec: &ParticleTableSpec,
+    optical_depth: &OpticalDepthTable,
+    scattering: &ScatteringTables,
+) -> Result<()> {
+    use cloudscape::image::HdrImage;
+    use cloudscape::particles::optical_depth::particle_rotation;
+    use cloudscape::particles::preview::DiscView;
+    use cloudscape::post::tonemap::{linear_to_srgb, quantize_u8};
+    use glam::{Quat, Vec3};
+    let n = PREVIEW_PIXELS;
+    let columns = PREVIEW_ANGLES_DEG.len() as u32;
+    let mut lit = HdrImage::new(n * columns, n);
+    let mut masses = vec![0.0f32; (n * n * columns) as usize];
+    let light = Vec3::new(0.2, -0.9, 0.3).normalize();
+    let axis = light.any_orthonormal_vector();
+    let sun = Vec3::from_array(scene.sun.color) * scene.sun.irradiance;
+    for (column, angle) in PREVIEW_ANGLES_DEG.iter().enumerate() {
+        let view = DiscView {
+            dir: Quat::from_axis_angle(axis, angle.to_radians()) * light,
+            pixels: n,
+        };
+        let (_, radiance) = view.scattering(scattering, &spec.phase, light, 2);
+        let mass = view.optical_mass(optical_depth, particle_rotation(column as u32));
+        for (k, (l, m)) in radiance.iter().zip(&mass).enumerate() {
+            let index = ((k as u32 / n) * n * columns + column as u32 * n + k as u32 % n) as usize;
+            let rgb = sun * *l;
+            lit.pixels[index] = [rgb.x, rgb.y, rgb.z, 1.0];
+            masses[index] = *m;
+        }
+    }
+    let mut image = lit.to_ldr(scene.render.exposure_ev, scene.render.tonemap);
+    let largest = masses.iter().copied().fold(0.0, f32::max).max(1e-6);
+    image.pixels.extend(masses.iter().map(|m| {
+        let grey = quantize_u8(linear_to_srgb(m / largest));
+        [grey, grey, grey, 255]
+    }));
+    image.height *= 2;
+    image
+        .write_png(path)
+        .with_context(|| format!("writing {}", path.display()))
 }
 
 /// Bakes the optical-depth table on the GPU `repeat` times, with the CPU bake beside it when

@@ -10,42 +10,38 @@
 use crate::integrator::PathTracer;
 use crate::medium::Medium;
 use crate::rng::Rng;
+use cloudscape::particles::preview::DiscView;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-/// An orthographic camera looking along `dir` at a square of side `2 half_extent_m` centred on
-/// `centre_m`, `pixels` on a side.
+/// An orthographic camera: the view of the particle's disc `disc` (its direction, pixels and
+/// image axes), scaled to a square of side `2 half_extent_m` centred on `centre_m`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OrthographicView {
-    /// Unit direction the camera looks along.
-    pub dir: Vec3,
+    /// Direction, pixels and axes.
+    pub disc: DiscView,
     /// Centre of the image square, m.
     pub centre_m: Vec3,
     /// Half the side of the image square, m.
     pub half_extent_m: f32,
-    /// Pixels per side.
-    pub pixels: u32,
 }
 
 impl OrthographicView {
-    /// The image axes (right, up).
-    pub fn axes(&self) -> (Vec3, Vec3) {
-        let right = self.dir.any_orthonormal_vector();
-        (right, self.dir.cross(right))
-    }
-
     /// The pixel `p` projects into, if any.
     fn pixel(&self, p: Vec3) -> Option<usize> {
-        let (right, up) = self.axes();
+        let (right, up) = self.disc.axes();
         let local = Vec2::new((p - self.centre_m).dot(right), (p - self.centre_m).dot(up));
-        let uv = (local / self.half_extent_m + 1.0) * 0.5 * self.pixels as f32;
-        let inside = uv.cmpge(Vec2::ZERO).all() && uv.cmplt(Vec2::splat(self.pixels as f32)).all();
-        inside.then(|| uv.y as usize * self.pixels as usize + uv.x as usize)
+        let uv = Vec2::new(local.x + self.half_extent_m, self.half_extent_m - local.y)
+            / (2.0 * self.half_extent_m)
+            * self.disc.pixels as f32;
+        let inside =
+            uv.cmpge(Vec2::ZERO).all() && uv.cmplt(Vec2::splat(self.disc.pixels as f32)).all();
+        inside.then(|| uv.y as usize * self.disc.pixels as usize + uv.x as usize)
     }
 
     /// Area of one pixel, m^2.
     fn pixel_area_m2(&self) -> f32 {
-        (2.0 * self.half_extent_m / self.pixels as f32).powi(2)
+        (2.0 * self.half_extent_m / self.disc.pixels as f32).powi(2)
     }
 }
 
@@ -80,7 +76,7 @@ pub fn light_trace<M: Medium>(
         views
             .iter()
             .map(|v| {
-                let n = (v.pixels * v.pixels) as usize;
+                let n = (v.disc.pixels * v.disc.pixels) as usize;
                 LightTracedImage {
                     single: vec![0.0; n],
                     total: vec![0.0; n],
@@ -137,7 +133,7 @@ fn trace_photon<M: Medium>(
             let Some(pixel) = view.pixel(position) else {
                 continue;
             };
-            let out = -view.dir;
+            let out = -view.disc.dir;
             let phase = tracer.phase.eval(dir.dot(out));
             let transmittance = tracer
                 .volume

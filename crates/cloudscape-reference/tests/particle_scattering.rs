@@ -4,6 +4,7 @@
 //! everything, from the front, the side and the back.
 
 use cloudscape::particles::ParticleTableSpec;
+use cloudscape::particles::preview::DiscView;
 use cloudscape::particles::scattering::ScatteringTables;
 use cloudscape::particles::store::{SHIPPED_SCATTERING, bake_scattering, scattering_from_file};
 use cloudscape::particles::table_file::{TableFile, TableKind};
@@ -29,37 +30,6 @@ const PIXELS: u32 = 10;
 const SUBSAMPLES: u32 = 6;
 /// Photons traced (shared by all views).
 const PHOTONS: u64 = 400_000;
-
-/// The tables' single and total radiance averaged over every pixel of `view`.
-fn table_image(
-    spec: &ParticleTableSpec,
-    tables: &ScatteringTables,
-    view: &OrthographicView,
-    light: Vec3,
-) -> (Vec<f64>, Vec<f64>) {
-    let (right, up) = view.axes();
-    let out = -view.dir;
-    let phase = spec.phase.eval(light.dot(out));
-    let n = view.pixels * SUBSAMPLES;
-    let mut single = vec![0.0; (view.pixels * view.pixels) as usize];
-    let mut total = single.clone();
-    for j in 0..n {
-        for i in 0..n {
-            let a = ((i as f32 + 0.5) / n as f32) * 2.0 - 1.0;
-            let b = ((j as f32 + 0.5) / n as f32) * 2.0 - 1.0;
-            if a * a + b * b >= 1.0 {
-                continue;
-            }
-            let entry = right * a + up * b - view.dir * (1.0 - a * a - b * b).sqrt();
-            let (s, m) = tables.lookup(entry, out, -light);
-            let pixel = ((j / SUBSAMPLES) * view.pixels + i / SUBSAMPLES) as usize;
-            let weight = 1.0 / f64::from(SUBSAMPLES * SUBSAMPLES);
-            single[pixel] += f64::from(phase * s) * weight;
-            total[pixel] += f64::from(phase * s + m) * weight;
-        }
-    }
-    (single, total)
-}
 
 /// Relative RMS difference of `estimate` from `expected` over the pixels whose centre is within
 /// 0.95 of the particle's radius.
@@ -87,16 +57,20 @@ fn compare(spec: &ParticleTableSpec, tables: &ScatteringTables, photons: u64) ->
     let views: Vec<OrthographicView> = VIEW_ANGLES_DEG
         .iter()
         .map(|(_, angle)| OrthographicView {
-            dir: Quat::from_axis_angle(axis, angle.to_radians()) * light,
+            disc: DiscView {
+                dir: Quat::from_axis_angle(axis, angle.to_radians()) * light,
+                pixels: PIXELS,
+            },
             centre_m: Vec3::ZERO,
             half_extent_m: spec.radius_m,
-            pixels: PIXELS,
         })
         .collect();
     let traced = light_trace(&tracer, Vec3::ZERO, spec.radius_m, &views, photons, 7);
     let mut worst = (0.0f64, 0.0f64);
     for (((name, angle), view), image) in VIEW_ANGLES_DEG.iter().zip(&views).zip(&traced) {
-        let (single, total) = table_image(spec, tables, view, light);
+        let (single, total) = view.disc.scattering(tables, &spec.phase, light, SUBSAMPLES);
+        let wide = |v: Vec<f32>| v.into_iter().map(f64::from).collect::<Vec<f64>>();
+        let (single, total) = (wide(single), wide(total));
         let e_single = relative_rms(&image.single, &single);
         let e_total = relative_rms(&image.total, &total);
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;

@@ -6,13 +6,15 @@
 //! - [`optical_depth`]: the 4D optical-depth table (CPU specification), [`gpu`] its GPU bake;
 //! - [`scattering`]: single and multiple scattering of the spherically symmetric particle, order by
 //!   order;
-//! - [`table_file`]: table files and their keys; [`store`]: the shipped tables and the cache.
+//! - [`table_file`]: table files and their keys; [`store`]: the shipped tables and the cache;
+//! - [`preview`]: orthographic pictures of the particle as the tables shade it.
 //!
 //! [`ParticleTableSpec`] gathers, from a scene, every input of the tables.
 
 pub mod density;
 pub mod gpu;
 pub mod optical_depth;
+pub mod preview;
 pub mod scattering;
 pub mod store;
 pub mod table_file;
@@ -82,24 +84,26 @@ impl ParticleTableSpec {
         }
     }
 
-    /// Key of the optical-depth table: its style, seed and size (it is in particle radii, so the
-    /// radius and extinction do not enter).
+    /// Key of the optical-depth table: the particle, the table's size and the bake's resolution
+    /// (the table is in particle radii, so the radius and extinction do not enter).
     pub fn optical_depth_key(&self) -> u64 {
         let l = self.optical_depth;
         let mut h = table_file::KeyHasher::new("optical depth");
-        h.u32(self.particle.style.gpu_index());
-        h.u32(self.particle.seed);
+        self.hash_particle(&mut h);
         for v in [l.start_zenith, l.start_azimuth, l.dir_zenith, l.dir_azimuth] {
             h.u32(v);
         }
+        h.u32(gpu::NOISE_VOLUME_SIZE);
+        h.u32(optical_depth::STEPS_PER_DIAMETER);
         h.finish()
     }
 
     /// Key of the scattering tables: everything the bake reads.
     pub fn scattering_key(&self) -> u64 {
         let mut h = table_file::KeyHasher::new("scattering");
-        h.u32(self.particle.style.gpu_index());
-        h.u32(self.particle.seed);
+        self.hash_particle(&mut h);
+        h.f32(scattering::orders::ORDER_TOLERANCE);
+        h.u32(scattering::orders::MAX_ORDERS);
         h.f32(self.radius_m * self.extinction_per_m);
         h.f32(self.albedo);
         for v in self.phase.to_gpu() {
@@ -117,6 +121,19 @@ impl ParticleTableSpec {
             h.u32(v);
         }
         h.finish()
+    }
+
+    /// The particle's style, seed and every constant of its density.
+    fn hash_particle(&self, h: &mut table_file::KeyHasher) {
+        let shape = self.particle.shape();
+        h.u32(self.particle.style.gpu_index());
+        h.u32(self.particle.seed);
+        for v in [shape.base_cells, shape.a, shape.b, shape.c] {
+            h.f32(v);
+        }
+        h.u32(density::NOISE_OCTAVES);
+        h.f32(density::NOISE_LACUNARITY);
+        h.f32(density::NOISE_GAIN);
     }
 }
 

@@ -98,6 +98,36 @@ fn texel_optical_mass(t: vec3<u32>) -> f32 {
     return sum * dt / max(chord_mass(normal, dir), 1e-7);
 }
 
+// The IEEE binary16 bits of `x`, rounded to nearest even as the CPU's half::f16::from_f32 rounds:
+// by hand, since pack2x16float needs a capability some backends lack.
+fn f16_bits(x: f32) -> u32 {
+    let bits = bitcast<u32>(x);
+    let sign = (bits >> 16u) & 0x8000u;
+    let exponent = i32((bits >> 23u) & 0xffu) - 112;
+    var mantissa = bits & 0x7fffffu;
+    if exponent >= 31 {
+        return sign | 0x7c00u;
+    }
+    var shift = 13u;
+    var base = sign | (u32(max(exponent, 0)) << 10u);
+    if exponent <= 0 {
+        // Subnormal: the implicit one joins the mantissa, shifted down further.
+        if exponent < -10 {
+            return sign;
+        }
+        mantissa |= 0x800000u;
+        shift = u32(14 - exponent);
+        base = sign;
+    }
+    let half = base | (mantissa >> shift);
+    let rest = mantissa & ((1u << shift) - 1u);
+    let midpoint = 1u << (shift - 1u);
+    if rest > midpoint || (rest == midpoint && (half & 1u) == 1u) {
+        return half + 1u;
+    }
+    return half;
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn bake_optical_depth(@builtin(global_invocation_id) id: vec3<u32>) {
     let dims = vec3<u32>(bake.table_dims.y, bake.table_dims.x, bake.table_dims.z * bake.table_dims.w);
@@ -111,7 +141,7 @@ fn bake_optical_depth(@builtin(global_invocation_id) id: vec3<u32>) {
         second = texel_optical_mass(vec3<u32>(x + 1u, id.y, id.z));
     }
     let row = id.z * dims.y + id.y;
-    optical_depth_words[row * bake.row_pitch_words + id.x] = pack2x16float(vec2<f32>(first, second));
+    optical_depth_words[row * bake.row_pitch_words + id.x] = f16_bits(first) | (f16_bits(second) << 16u);
 }
 
 // Look-up probe: chord `i` is (entry, direction) at noise_voxels[6 i .. 6 i + 6]; its looked-up
