@@ -15,7 +15,7 @@ const MAGIC: &[u8; 8] = b"CSLUT\0\0\0";
 pub const FORMAT_VERSION: u32 = 1;
 /// Version of the bake algorithms: part of every key, so a change to how tables are computed
 /// makes every cached table stale.
-pub const BAKE_VERSION: u32 = 1;
+pub const BAKE_VERSION: u32 = 2;
 const HEADER_BYTES: usize = 8 + 4 + 4 + 8 + 16 + 4;
 
 /// Which table a file holds.

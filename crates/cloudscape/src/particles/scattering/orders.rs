@@ -111,7 +111,11 @@ impl OrderField {
         let coords = [
             cell_coordinate(r, 1.0, g.radii),
             cell_coordinate(polar, PI, g.polar),
-            cell_coordinate(zenith, PI, g.directions.zeniths),
+            cell_coordinate(
+                DirectionGrid::zenith_coordinate(zenith),
+                1.0,
+                g.directions.zeniths,
+            ),
             cell_coordinate(azimuth.abs(), PI, g.directions.azimuths),
         ];
         let dims = [
