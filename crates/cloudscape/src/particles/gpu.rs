@@ -142,7 +142,9 @@ impl OpticalDepthBaker {
     }
 
     /// Looks up `chords` (entry point, inward direction) in `lut` through the WGSL look-up and
-    /// the texture's hardware filtering: what a shading pass reads. Waits for the GPU.
+    /// the texture's hardware filtering, chord `i` as particle `i` sees it (turned by
+    /// [`super::optical_depth::particle_rotation`]`(i)`): what a shading pass reads. Waits for
+    /// the GPU.
     pub fn probe(
         &self,
         ctx: &GpuContext,

@@ -69,6 +69,26 @@ fn particle_chord_position(entry: vec3<f32>, dir: vec3<f32>, nodes: u32) -> vec2
     return vec2<f32>(f32(i), x - f32(i));
 }
 
+// The random orientation of particle `id` as a unit quaternion (x, y, z, w): particle_rotation in
+// optical_depth.rs (Shoemake 1992, uniform over all rotations).
+fn particle_rotation(id: u32) -> vec4<f32> {
+    let h1 = noise_pcg_hash(id ^ 0x2c1b3c6du);
+    let h2 = noise_pcg_hash(h1);
+    let h3 = noise_pcg_hash(h2);
+    let u1 = noise_hash_to_unit(h1);
+    let a = sqrt(1.0 - u1);
+    let b = sqrt(u1);
+    let t2 = 2.0 * PI * noise_hash_to_unit(h2);
+    let t3 = 2.0 * PI * noise_hash_to_unit(h3);
+    return normalize(vec4<f32>(a * sin(t2), a * cos(t2), b * sin(t3), b * cos(t3)));
+}
+
+// `v` rotated by the unit quaternion `q`.
+fn particle_rotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
+    let t = 2.0 * cross(q.xyz, v);
+    return v + q.w * t + cross(q.xyz, t);
+}
+
 // A style's constants: the noise's first-octave cells per radius and three style parameters.
 struct ParticleShape {
     base_cells: f32,

@@ -144,8 +144,9 @@ fn bake_optical_depth(@builtin(global_invocation_id) id: vec3<u32>) {
     optical_depth_words[row * bake.row_pitch_words + id.x] = f16_bits(first) | (f16_bits(second) << 16u);
 }
 
-// Look-up probe: chord `i` is (entry, direction) at noise_voxels[6 i .. 6 i + 6]; its looked-up
-// optical mass goes to noise_voxels[6 * query_count + i].
+// Look-up probe: chord `i` is (entry, direction) at noise_voxels[6 i .. 6 i + 6], looked up as
+// particle `i` sees it (turned by particle_rotation(i)); the optical mass goes to
+// noise_voxels[6 * query_count + i].
 @group(3) @binding(3) var optical_depth_lut: texture_3d<f32>;
 @group(3) @binding(4) var optical_depth_sampler: sampler;
 
@@ -157,8 +158,11 @@ fn probe_optical_depth(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let entry = vec3<f32>(noise_voxels[6u * i], noise_voxels[6u * i + 1u], noise_voxels[6u * i + 2u]);
     let dir = vec3<f32>(noise_voxels[6u * i + 3u], noise_voxels[6u * i + 4u], noise_voxels[6u * i + 5u]);
-    let taps = particle_optical_depth_taps(entry, dir, bake.table_dims);
+    let turn = particle_rotation(i);
+    let local_entry = particle_rotate(turn, entry);
+    let local_dir = particle_rotate(turn, dir);
+    let taps = particle_optical_depth_taps(local_entry, local_dir, bake.table_dims);
     let a = textureSampleLevel(optical_depth_lut, optical_depth_sampler, taps.uvw0, 0.0).x;
     let b = textureSampleLevel(optical_depth_lut, optical_depth_sampler, taps.uvw1, 0.0).x;
-    noise_voxels[6u * bake.query_count + i] = mix(a, b, taps.weight) * chord_mass(normalize(entry), normalize(dir));
+    noise_voxels[6u * bake.query_count + i] = mix(a, b, taps.weight) * chord_mass(normalize(local_entry), normalize(local_dir));
 }
