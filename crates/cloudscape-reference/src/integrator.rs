@@ -286,7 +286,7 @@ const ROULETTE_THRESHOLD: f32 = 0.25;
 /// throughput `beta` has fallen below [`ROULETTE_THRESHOLD`] survives with probability
 /// `max(beta) / threshold` and then carries `beta * threshold / max(beta)`, which keeps every
 /// estimate unbiased. Returns whether the path goes on.
-fn roulette(throughput: &mut Vec3, rng: &mut Rng) -> bool {
+pub(crate) fn roulette(throughput: &mut Vec3, rng: &mut Rng) -> bool {
     let largest = throughput.max_element();
     if largest >= ROULETTE_THRESHOLD {
         return true;

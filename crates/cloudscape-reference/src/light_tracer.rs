@@ -10,6 +10,7 @@
 use crate::integrator::PathTracer;
 use crate::medium::Medium;
 use crate::rng::Rng;
+use cloudscape::particles::density::uniform_disc_point;
 use cloudscape::particles::preview::DiscView;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -57,6 +58,9 @@ pub struct LightTracedImage {
 /// Traces `photons` photons from `tracer`'s sun into the ball of radius `radius_m` about
 /// `centre_m` (which must hold all of the medium), and images the light leaving it in `views`.
 /// The sky, the ground and the haze are ignored: these are images of sunlight alone.
+///
+/// # Panics
+/// When `tracer` has no sun.
 pub fn light_trace<M: Medium>(
     tracer: &PathTracer<M>,
     centre_m: Vec3,
@@ -90,10 +94,8 @@ pub fn light_trace<M: Medium>(
         .fold(empty, |mut images, chunk| {
             for k in chunk * CHUNK..((chunk + 1) * CHUNK).min(photons) {
                 let mut rng = Rng::for_sample(seed, 0, k);
-                let d = rng.next_vec2();
-                let (r, a) = (d.x.sqrt() * radius_m, d.y * std::f32::consts::TAU);
-                let start =
-                    centre_m - light * (2.0 * radius_m) + (right * a.cos() + up * a.sin()) * r;
+                let d = uniform_disc_point(rng.next_vec2()) * radius_m;
+                let start = centre_m - light * (2.0 * radius_m) + right * d.x + up * d.y;
                 trace_photon(tracer, start, light, views, &mut images, &mut rng);
             }
             images
@@ -122,13 +124,13 @@ fn trace_photon<M: Medium>(
     images: &mut [LightTracedImage],
     rng: &mut Rng,
 ) {
-    let mut weight = 1.0f64;
+    let mut weight = Vec3::ONE;
     for order in 1..=crate::integrator::MAX_SCATTERING_EVENTS {
         let Some(t) = tracer.volume.free_flight(position, dir, f32::INFINITY, rng) else {
             return;
         };
         position += dir * t;
-        weight *= f64::from(tracer.albedo);
+        weight *= tracer.albedo;
         for (view, image) in views.iter().zip(images.iter_mut()) {
             let Some(pixel) = view.pixel(position) else {
                 continue;
@@ -138,19 +140,15 @@ fn trace_photon<M: Medium>(
             let transmittance = tracer
                 .volume
                 .transmittance(position, out, f32::INFINITY, rng);
-            let value = weight * f64::from(phase * transmittance);
+            let value = f64::from(weight.y * phase * transmittance);
             image.total[pixel] += value;
             if order == 1 {
                 image.single[pixel] += value;
             }
         }
         dir = tracer.phase.sample(dir, rng.next_vec3());
-        if weight < 0.1 {
-            // Russian roulette (Arvo & Kirk 1990), unbiased.
-            if f64::from(rng.next_f32()) >= weight / 0.1 {
-                return;
-            }
-            weight = 0.1;
+        if !crate::integrator::roulette(&mut weight, rng) {
+            return;
         }
     }
 }

@@ -6,7 +6,7 @@
 //! most 1 inside. A real particle of radius `R` and peak extinction `sigma` has extinction
 //! `sigma * density(p / R)`. `particle_density` in `optical_depth.wgsl` is the GPU twin.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::field::noise::perlin;
 use crate::scene::ParticleStyle;
@@ -193,23 +193,12 @@ impl NoiseVolume {
     /// `volume_noise` in `particle_bake.wgsl`.
     pub fn sample(&self, p: Vec3) -> f32 {
         let n = self.size as i32;
-        let x = ((p + 1.0) * 0.5 * self.size as f32 - 0.5)
-            .clamp(Vec3::ZERO, Vec3::splat((n - 1) as f32));
-        let base = x
-            .floor()
-            .as_ivec3()
-            .min(glam::IVec3::splat(n - 2).max(glam::IVec3::ZERO));
-        let f = x - base.as_vec3();
-        let at = |dx: i32, dy: i32, dz: i32| {
-            let c = (base + glam::IVec3::new(dx, dy, dz)).min(glam::IVec3::splat(n - 1));
-            self.values[(c.x + n * (c.y + n * c.z)) as usize]
+        let fetch = |t: glam::IVec3| {
+            let c = t.clamp(glam::IVec3::ZERO, glam::IVec3::splat(n - 1));
+            glam::Vec4::splat(self.values[(c.x + n * (c.y + n * c.z)) as usize])
         };
-        let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-        let x00 = lerp(at(0, 0, 0), at(1, 0, 0), f.x);
-        let x10 = lerp(at(0, 1, 0), at(1, 1, 0), f.x);
-        let x01 = lerp(at(0, 0, 1), at(1, 0, 1), f.x);
-        let x11 = lerp(at(0, 1, 1), at(1, 1, 1), f.x);
-        lerp(lerp(x00, x10, f.y), lerp(x01, x11, f.y), f.z)
+        crate::field::texture::sample_linear(glam::UVec3::splat(self.size), (p + 1.0) * 0.5, fetch)
+            .x
     }
 }
 
@@ -286,6 +275,20 @@ impl RadialProfile {
             .fold(0.0, f32::max);
         inner.max(self.at(r0)).max(self.at(r1))
     }
+}
+
+/// A uniform point on the unit sphere from two uniform numbers in [0, 1).
+pub fn uniform_sphere_point(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (s, c) = (std::f32::consts::TAU * u.y).sin_cos();
+    Vec3::new(r * c, r * s, z)
+}
+
+/// A uniform point in the unit disc from two uniform numbers in [0, 1) (`r = sqrt(u.x)`).
+pub fn uniform_disc_point(u: Vec2) -> Vec2 {
+    let (s, c) = (std::f32::consts::TAU * u.y).sin_cos();
+    Vec2::new(c, s) * u.x.sqrt()
 }
 
 /// Direction `k` of `count` spread evenly over the sphere (the Fibonacci lattice, González 2010,

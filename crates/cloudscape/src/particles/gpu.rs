@@ -8,7 +8,7 @@ use glam::Vec3;
 use half::f16;
 use wgpu::util::DeviceExt;
 
-use super::density::{ParticleShape, RadialProfile, ReferenceParticle};
+use super::density::{ParticleShape, ReferenceParticle};
 use super::optical_depth::{
     ChordProfile, OpticalDepthLayout, OpticalDepthTable, STEPS_PER_DIAMETER,
 };
@@ -113,7 +113,7 @@ impl OpticalDepthBaker {
             "optical depth",
             u64::from(row_pitch_words * dims.y * dims.z) * 4,
         );
-        let chords = ChordProfile::of(&RadialProfile::of(particle));
+        let chords = ChordProfile::of_particle(particle);
         let lut = create_lut(ctx, layout, chords);
         let group = self.group(ctx, &uniform, &voxels, &words, &lut);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -215,23 +215,6 @@ impl OpticalDepthBaker {
 }
 
 impl OpticalDepthLut {
-    /// Uploads a table baked (or loaded) on the CPU.
-    pub fn upload(ctx: &GpuContext, table: &OpticalDepthTable) -> OpticalDepthLut {
-        let lut = create_lut(ctx, table.layout, table.chords.clone());
-        let dims = table.layout.texture_dims();
-        ctx.queue.write_texture(
-            lut.texture.as_image_copy(),
-            bytemuck::cast_slice(&table.values),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(dims.x * 2),
-                rows_per_image: Some(dims.y),
-            },
-            extent(dims),
-        );
-        lut
-    }
-
     /// Reads the table back (waits for the GPU).
     pub fn read(&self, ctx: &GpuContext) -> OpticalDepthTable {
         let bytes = crate::gpu::readback::read_texture(ctx, &self.texture);

@@ -15,11 +15,11 @@
 //! This module is the CPU specification: the parameterisation, the bake and the look-up, which the
 //! GPU twins (`optical_depth.wgsl`, [`super::gpu`]) must match.
 
-use glam::{IVec3, UVec3, Vec3, Vec4};
+use glam::{IVec3, UVec3, Vec2, Vec3, Vec4};
 use half::f16;
 use std::f32::consts::{FRAC_PI_2, PI, TAU};
 
-use super::density::{NoiseVolume, RadialProfile};
+use super::density::{NoiseVolume, RadialProfile, ReferenceParticle, uniform_sphere_point};
 
 /// Sizes of the four dimensions of an optical-depth table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -149,6 +149,11 @@ pub const CHORD_NODES: usize = 256;
 const CHORD_STEPS: usize = 128;
 
 impl ChordProfile {
+    /// The chord masses of `particle`'s direction-averaged density.
+    pub fn of_particle(particle: &ReferenceParticle) -> ChordProfile {
+        ChordProfile::of(&RadialProfile::of(particle))
+    }
+
     /// The chord masses of `profile`.
     pub fn of(profile: &RadialProfile) -> ChordProfile {
         let mean_density = (0..CHORD_NODES)
@@ -203,7 +208,7 @@ impl OpticalDepthTable {
     /// Bakes the table on the CPU through `volume` (the specification of the GPU bake).
     pub fn bake_cpu(layout: OpticalDepthLayout, volume: &NoiseVolume) -> OpticalDepthTable {
         use rayon::prelude::*;
-        let chords = ChordProfile::of(&RadialProfile::of(&volume.particle));
+        let chords = ChordProfile::of_particle(&volume.particle);
         let dims = layout.texture_dims();
         let values = (0..layout.len())
             .into_par_iter()
@@ -350,8 +355,8 @@ pub fn random_chords(count: u32) -> Vec<(Vec3, Vec3)> {
         hash_to_unit(state)
     };
     while out.len() < count as usize {
-        let entry = sphere_point(next(), next());
-        let local = sphere_point(next(), next());
+        let entry = uniform_sphere_point(Vec2::new(next(), next()));
+        let local = uniform_sphere_point(Vec2::new(next(), next()));
         let dir = if local.dot(entry) > 0.0 {
             -local
         } else {
@@ -362,14 +367,6 @@ pub fn random_chords(count: u32) -> Vec<(Vec3, Vec3)> {
         }
     }
     out
-}
-
-/// A uniform point on the unit sphere from two uniform numbers.
-fn sphere_point(u: f32, v: f32) -> Vec3 {
-    let z = 1.0 - 2.0 * u;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let (s, c) = (TAU * v).sin_cos();
-    Vec3::new(r * c, r * s, z)
 }
 
 /// The random orientation of particle `id`, uniform over all rotations (Shoemake 1992, "Uniform

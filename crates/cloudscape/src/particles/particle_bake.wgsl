@@ -44,8 +44,7 @@ fn bake_particle_noise(@builtin(global_invocation_id) id: vec3<u32>) {
 
 fn voxel(c: vec3<i32>) -> f32 {
     let n = i32(bake.volume_size);
-    let k = min(c, vec3<i32>(n - 1));
-    return noise_voxels[u32(k.x + n * (k.y + n * k.z))];
+    return noise_voxels[u32(c.x + n * (c.y + n * c.z))];
 }
 
 // Trilinear noise, clamped to the edge voxels: NoiseVolume::sample.

@@ -6,7 +6,7 @@ use half::f16;
 use std::path::{Path, PathBuf};
 
 use super::ParticleTableSpec;
-use super::density::{RadialProfile, ReferenceParticle};
+use super::density::ReferenceParticle;
 use super::optical_depth::{ChordProfile, OpticalDepthLayout, OpticalDepthTable};
 use super::scattering::{BakeReport, Progress, ScatteringLayout, ScatteringTables};
 use super::table_file::{TableError, TableFile, TableKind, TableProblem};
@@ -159,7 +159,7 @@ pub fn optical_depth_from_file(
             dir_azimuth,
         },
         values: file.values.clone(),
-        chords: ChordProfile::of(&RadialProfile::of(particle)),
+        chords: ChordProfile::of_particle(particle),
     }
 }
 

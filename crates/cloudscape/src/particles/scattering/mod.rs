@@ -27,6 +27,7 @@ pub use medium::{SunDepth, SymmetricParticle};
 pub use orders::{MultipleScattering, OrderGrid};
 
 use crate::field::texture::sample_linear;
+use crate::particles::density::{uniform_disc_point, uniform_sphere_point};
 
 /// Sizes of the final tables.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -165,7 +166,7 @@ impl ScatteringTables {
     }
 
     /// Normalised texture coordinates of a look-up (see [`Self::lookup`]).
-    pub fn texture_coordinates(&self, point: Vec3, out: Vec3, to_light: Vec3) -> Vec3 {
+    fn texture_coordinates(&self, point: Vec3, out: Vec3, to_light: Vec3) -> Vec3 {
         let n = point.normalize();
         let cos_entry = n.dot(to_light).clamp(-1.0, 1.0);
         let away = n * cos_entry - to_light;
@@ -211,9 +212,9 @@ impl ScatteringTables {
         let (mut single, mut multiple, mut transmitted) = (0.0f64, 0.0f64, 0.0f64);
         for i in 0..samples {
             let u = |k: usize| ((i as f64 + 0.5) * KRONECKER[k]).fract() as f32;
-            let disc = unit_disc(u(0), u(1));
+            let disc = uniform_disc_point(glam::Vec2::new(u(0), u(1)));
             let phase_dir = particle.phase.sample(light, Vec3::new(u(2), u(3), u(4)));
-            let uniform_dir = uniform_sphere(u(2), u(3));
+            let uniform_dir = uniform_sphere_point(glam::Vec2::new(u(2), u(3)));
             single += f64::from(self.exit_lookup(disc, phase_dir, light).0);
             multiple += f64::from(self.exit_lookup(disc, uniform_dir, light).1);
             let exit = Vec3::new(
@@ -250,18 +251,3 @@ const KRONECKER: [f64; 5] = [
     2.645_751_311_064_590_6,
     3.316_624_790_355_4,
 ];
-
-/// Uniform point in the unit disc (concentric-free polar map: `r = sqrt(u)`).
-fn unit_disc(u: f32, v: f32) -> glam::Vec2 {
-    let r = u.sqrt();
-    let (s, c) = (2.0 * PI * v).sin_cos();
-    glam::Vec2::new(r * c, r * s)
-}
-
-/// Uniform direction on the unit sphere.
-fn uniform_sphere(u: f32, v: f32) -> Vec3 {
-    let z = 1.0 - 2.0 * u;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let (s, c) = (2.0 * PI * v).sin_cos();
-    Vec3::new(r * c, r * s, z)
-}
