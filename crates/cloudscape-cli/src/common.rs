@@ -24,6 +24,9 @@ pub struct SceneArgs {
     /// Image height in pixels (same as `--set render.height=H`).
     #[arg(long)]
     pub height: Option<u32>,
+    /// Renderer: raymarch or particles (same as `--set render.technique=NAME`).
+    #[arg(long, value_name = "NAME")]
+    pub technique: Option<String>,
 }
 
 impl SceneArgs {
@@ -32,6 +35,11 @@ impl SceneArgs {
         let mut overrides = self.overrides.clone();
         overrides.extend(self.width.map(|w| format!("render.width={w}")));
         overrides.extend(self.height.map(|h| format!("render.height={h}")));
+        overrides.extend(
+            self.technique
+                .as_ref()
+                .map(|t| format!("render.technique={t}")),
+        );
         overrides.extend_from_slice(extra);
         Ok(SceneDocument::load(self.scene.as_deref(), &overrides)?)
     }

@@ -161,6 +161,7 @@ fn load(canonical: &Canonical, args: &ReportArgs, voxel_dir: &Path) -> Result<Sc
         overrides: overrides.iter().map(|s| s.to_string()).collect(),
         width: Some(args.width),
         height: Some(args.height),
+        technique: None,
     };
     scene_args.load(&[])
 }

@@ -48,6 +48,18 @@ pub const MODULES: &[WgslModule] = &[
         "particle_bake",
         include_str!("particles/particle_bake.wgsl"),
     ),
+    module(
+        "particle_lookup",
+        include_str!("particles/particle_lookup.wgsl"),
+    ),
+    module(
+        "particle_generate",
+        include_str!("particles/particle_generate.wgsl"),
+    ),
+    module(
+        "particle_render",
+        include_str!("particles/particle_render.wgsl"),
+    ),
 ];
 
 /// The modules with entry points: every pipeline the crate builds starts from one of these.
@@ -59,6 +71,8 @@ pub const PROGRAMS: &[&str] = &[
     "display",
     "probe",
     "particle_bake",
+    "particle_generate",
+    "particle_render",
 ];
 
 /// Bind group slots shared by every program: the field, the frame, the environment; each pass

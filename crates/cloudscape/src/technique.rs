@@ -35,6 +35,9 @@ pub trait Technique {
     /// The scene-file name (`render.technique`).
     fn name(&self) -> &'static str;
 
+    /// The labels its passes are timed under, in the order it records them.
+    fn pass_names(&self) -> &'static [&'static str];
+
     /// Takes this frame's settings (steps, lighting, phase function) from `scene`.
     fn prepare(&mut self, ctx: &GpuContext, scene: &Scene);
 

@@ -263,6 +263,18 @@ impl RadialProfile {
 }
 
 impl RadialProfile {
+    /// Mean density over the unit ball, `integral of rho(r) 3 r^2 dr` over [0, 1] (0.195 for the
+    /// bare metaball falloff): the particle's mass relative to a uniform ball of density 1.
+    pub fn volume_mean(&self) -> f32 {
+        let n = 4 * self.density.len();
+        (0..n)
+            .map(|i| {
+                let r = (i as f32 + 0.5) / n as f32;
+                self.at(r) * 3.0 * r * r / n as f32
+            })
+            .sum()
+    }
+
     /// The largest density at any radius in `[r0, r1]` (an exact bound of [`Self::at`], which
     /// is linear between samples).
     pub fn max_between(&self, r0: f32, r1: f32) -> f32 {

@@ -11,13 +11,19 @@
 //!
 //! [`ParticleTableSpec`] gathers, from a scene, every input of the tables.
 
+pub mod blend;
 pub mod density;
+pub mod generate;
+pub mod generate_gpu;
 pub mod gpu;
+pub mod grid;
 pub mod optical_depth;
 pub mod preview;
+pub mod render;
 pub mod scattering;
 pub mod store;
 pub mod table_file;
+pub mod tables_gpu;
 
 use crate::optics::PhaseLobes;
 use crate::scene::{Scene, TableResolution};

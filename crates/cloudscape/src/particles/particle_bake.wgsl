@@ -1,4 +1,4 @@
-#import particle
+#import particle particle_lookup
 // Bakes the optical-depth table of the reference particle (particles/gpu.rs): the particle's
 // noise into a voxel buffer, then the optical-mass ratio of every chord through it, packed two 16-bit
 // floats per word in rows padded for copy_buffer_to_texture. A buffer rather than a storage
@@ -21,16 +21,7 @@ struct ParticleBake {
 @group(3) @binding(0) var<uniform> bake: ParticleBake;
 @group(3) @binding(1) var<storage, read_write> noise_voxels: array<f32>;
 @group(3) @binding(2) var<storage, read_write> optical_depth_words: array<u32>;
-// ChordProfile::mean_density.
-@group(3) @binding(5) var<storage, read> chord_mean_density: array<f32>;
-
-// ChordProfile::mass.
-fn chord_mass(entry: vec3<f32>, dir: vec3<f32>) -> f32 {
-    let at = particle_chord_position(entry, dir, arrayLength(&chord_mean_density));
-    let i = u32(at.x);
-    let mean = mix(chord_mean_density[i], chord_mean_density[i + 1u], at.y);
-    return 2.0 * clamp(-dot(entry, dir), 0.0, 1.0) * mean;
-}
+// Bindings 3-5 (the baked table, its sampler and the chord masses): particle_lookup.wgsl.
 
 @compute @workgroup_size(4, 4, 4)
 fn bake_particle_noise(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -146,8 +137,6 @@ fn bake_optical_depth(@builtin(global_invocation_id) id: vec3<u32>) {
 // Look-up probe: chord `i` is (entry, direction) at noise_voxels[6 i .. 6 i + 6], looked up as
 // particle `i` sees it (turned by particle_rotation(i)); the optical mass goes to
 // noise_voxels[6 * query_count + i].
-@group(3) @binding(3) var optical_depth_lut: texture_3d<f32>;
-@group(3) @binding(4) var optical_depth_sampler: sampler;
 
 @compute @workgroup_size(64)
 fn probe_optical_depth(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -160,8 +149,5 @@ fn probe_optical_depth(@builtin(global_invocation_id) id: vec3<u32>) {
     let turn = particle_rotation(i);
     let local_entry = particle_rotate(turn, entry);
     let local_dir = particle_rotate(turn, dir);
-    let taps = particle_optical_depth_taps(local_entry, local_dir, bake.table_dims);
-    let a = textureSampleLevel(optical_depth_lut, optical_depth_sampler, taps.uvw0, 0.0).x;
-    let b = textureSampleLevel(optical_depth_lut, optical_depth_sampler, taps.uvw1, 0.0).x;
-    noise_voxels[6u * bake.query_count + i] = mix(a, b, taps.weight) * chord_mass(normalize(local_entry), normalize(local_dir));
+    noise_voxels[6u * bake.query_count + i] = particle_optical_mass(local_entry, local_dir, bake.table_dims);
 }

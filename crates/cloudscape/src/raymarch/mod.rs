@@ -205,6 +205,10 @@ impl Technique for RaymarchRenderer {
         "raymarch"
     }
 
+    fn pass_names(&self) -> &'static [&'static str] {
+        &["raymarch"]
+    }
+
     fn prepare(&mut self, ctx: &GpuContext, scene: &Scene) {
         self.set_settings(ctx, &MarchSettings::from_scene(scene));
     }

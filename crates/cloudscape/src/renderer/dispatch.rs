@@ -3,6 +3,7 @@
 use crate::field::FieldError;
 use crate::frame::Shared;
 use crate::gpu::GpuContext;
+use crate::particles::render::ParticleRenderer;
 use crate::raymarch::RaymarchRenderer;
 use crate::scene::Technique as TechniqueName;
 use crate::technique::Technique;
@@ -17,7 +18,8 @@ pub fn build(
 ) -> Result<Box<dyn Technique>, FieldError> {
     match name {
         TechniqueName::Raymarch => Ok(Box::new(RaymarchRenderer::new(ctx, shared))),
-        TechniqueName::Particles | TechniqueName::Sprites => {
+        TechniqueName::Particles => Ok(Box::new(ParticleRenderer::new(ctx, shared))),
+        TechniqueName::Sprites => {
             let built: Vec<&str> = TechniqueName::BUILT.iter().map(|t| t.name()).collect();
             Err(FieldError {
                 key_path: "render.technique".into(),
@@ -51,10 +53,10 @@ mod tests {
         for name in TechniqueName::BUILT {
             assert_eq!(build(&ctx, &shared, *name).unwrap().name(), name.name());
         }
-        for name in [TechniqueName::Particles, TechniqueName::Sprites] {
+        for name in [TechniqueName::Sprites] {
             let error = build(&ctx, &shared, name).err().expect("not built");
             assert!(
-                error.message.contains("built: raymarch"),
+                error.message.contains("built: raymarch, particles"),
                 "{}",
                 error.message
             );

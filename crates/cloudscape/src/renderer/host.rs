@@ -156,14 +156,15 @@ impl CloudRenderer {
     }
 
     /// The labels of a frame's passes as a [`PassTimer`] records them, in order: the technique's
-    /// name, "temporal resolve" (with temporal reuse), "compose", "display".
-    pub fn pass_names(&self) -> [&'static str; 4] {
-        [
-            self.technique.name(),
-            "temporal resolve",
-            "compose",
-            "display",
-        ]
+    /// ([`Technique::pass_names`]), "temporal resolve" (with temporal reuse), "compose", "display".
+    pub fn pass_names(&self) -> Vec<&'static str> {
+        let shared = ["temporal resolve", "compose", "display"];
+        self.technique
+            .pass_names()
+            .iter()
+            .copied()
+            .chain(shared)
+            .collect()
     }
 
     /// Starts a frame: uploads `frame`, the scene's environment, the field's time and the

@@ -22,9 +22,9 @@ use std::time::{Duration, Instant};
 /// Rows of output texels rendered per submission when reporting progress.
 const TILE_ROWS: u32 = 32;
 
-/// GPU passes of one frame at most: the technique, the temporal resolve, compose and display
-/// ([`CloudRenderer::pass_names`]); a [`PassTimer`] of this capacity times them all.
-pub const PASS_COUNT: u32 = 4;
+/// GPU passes of one frame at most: the technique's (up to three), the temporal resolve, compose
+/// and display ([`CloudRenderer::pass_names`]); a [`PassTimer`] of this capacity times them all.
+pub const PASS_COUNT: u32 = 6;
 
 /// The images of one render.
 pub struct Rendered {
@@ -95,7 +95,7 @@ impl SceneRenderer {
     }
 
     /// The labels of a frame's passes ([`CloudRenderer::pass_names`]).
-    pub fn pass_names(&self) -> [&'static str; 4] {
+    pub fn pass_names(&self) -> Vec<&'static str> {
         self.clouds.pass_names()
     }
 

@@ -498,6 +498,30 @@ pub struct Particles {
     pub radius_m: f32,
     /// How finely the tables are sampled.
     pub table_resolution: TableResolution,
+    /// Concentric rings of the camera-centred cell grid, 1..8 (Yusov's sample: 5); each ring's
+    /// cells are twice the size of the inner ring's.
+    pub rings: u32,
+    /// Cells along each side of a ring, even, 16..512 (Yusov: 136, the inner 128 plus 4 on each
+    /// side); rings past the first skip their centre.
+    pub ring_cells: u32,
+    /// Particles stacked in each cell across the layer band, 1..16 (Yusov: 4).
+    pub cell_layers: u32,
+    /// Reach of the cell grid from the camera, m, 1000..1e6 (Yusov: 200 km); it sets the cell size.
+    pub distance_m: f32,
+    /// How overlapping particles are blended.
+    pub blending: ParticleBlending,
+    /// Particles render at 1/divisor of the image resolution: 1, 2 or 4 (Yusov: 2).
+    pub resolution_divisor: u32,
+}
+
+/// How the particle technique blends particles that overlap along a view ray.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ParticleBlending {
+    /// Yusov 2014's volume-aware blending: overlapping particles merge as one volume.
+    VolumeAware,
+    /// Conventional alpha blending in distance order, for comparison.
+    Alpha,
 }
 
 /// How finely the particle tables are sampled (sizes in `particles::ParticleTableSpec`).
@@ -518,6 +542,12 @@ impl Default for Particles {
             style: ParticleStyle::Smooth,
             radius_m: 200.0,
             table_resolution: TableResolution::Standard,
+            rings: 5,
+            ring_cells: 136,
+            cell_layers: 4,
+            distance_m: 200_000.0,
+            blending: ParticleBlending::VolumeAware,
+            resolution_divisor: 2,
         }
     }
 }
@@ -536,7 +566,7 @@ pub enum Technique {
 
 impl Technique {
     /// The techniques this build can render (the renderer's dispatch builds each of them).
-    pub const BUILT: &[Technique] = &[Technique::Raymarch];
+    pub const BUILT: &[Technique] = &[Technique::Raymarch, Technique::Particles];
 
     /// The name scene files use.
     pub fn name(self) -> &'static str {

@@ -228,6 +228,11 @@ const SCENE_RULES: &[Rule<Scene>] = &[
     rule("lighting.octave_eccentricity", Between(0.0, 1.0), "", |s| Float(s.lighting.octave_eccentricity)),
     rule("lighting.ambient_scale", Between(0.0, 4.0), "", |s| Float(s.lighting.ambient_scale)),
     rule("particles.radius_m", Between(10.0, 5000.0), "m", |s| Float(s.particles.radius_m)),
+    rule("particles.rings", Between(1.0, 8.0), "", |s| Int(s.particles.rings)),
+    rule("particles.ring_cells", Between(16.0, 512.0), "", |s| Int(s.particles.ring_cells)),
+    rule("particles.cell_layers", Between(1.0, 16.0), "", |s| Int(s.particles.cell_layers)),
+    rule("particles.distance_m", Between(1.0e3, 1.0e6), "m", |s| Float(s.particles.distance_m)),
+    rule("particles.resolution_divisor", Between(1.0, 4.0), "", |s| Int(s.particles.resolution_divisor)),
     rule("render.width", AtLeast(1.0), "px", |s| Int(s.render.width)),
     rule("render.height", AtLeast(1.0), "px", |s| Int(s.render.height)),
     rule("render.primary_steps", Between(1.0, 4096.0), "", |s| optional_int(s.render.primary_steps)),
@@ -313,6 +318,8 @@ const SCENE_RELATIONS: &[Relation<Scene>] = &[
     Relation { key: "weather.source", broken: weather_file_without_path },
     Relation { key: "render.output", broken: output_not_png_or_exr },
     Relation { key: "render.technique", broken: technique_not_built },
+    Relation { key: "particles.ring_cells", broken: ring_cells_odd },
+    Relation { key: "particles.resolution_divisor", broken: divisor_not_1_2_or_4 },
 ];
 
 #[rustfmt::skip]
@@ -335,6 +342,16 @@ fn technique_not_built(scene: &Scene) -> Option<String> {
             built.join(", ")
         )
     })
+}
+
+fn ring_cells_odd(scene: &Scene) -> Option<String> {
+    let cells = scene.particles.ring_cells;
+    (cells % 2 == 1).then(|| format!("{cells} is odd; a ring needs an even number of cells"))
+}
+
+fn divisor_not_1_2_or_4(scene: &Scene) -> Option<String> {
+    let divisor = scene.particles.resolution_divisor;
+    (![1, 2, 4].contains(&divisor)).then(|| format!("{divisor} is not 1, 2 or 4"))
 }
 
 fn far_not_beyond_near(scene: &Scene) -> Option<String> {

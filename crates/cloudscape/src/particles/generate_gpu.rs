@@ -1,0 +1,280 @@
+//! Particle generation on the GPU (`particle_generate.wgsl`): the twin of [`super::generate`].
+//! Each frame: one invocation per grid column lists the non-empty cells into an append buffer,
+//! one more sizes the indirect dispatches, and an indirect dispatch makes the particles of the
+//! listed cells (Yusov 2014's DispatchIndirect).
+
+use bytemuck::{Pod, Zeroable};
+
+use super::generate::{Generation, ListedCell, Particle};
+use crate::frame::{Shared, SharedSlots};
+use crate::gpu::GpuContext;
+use crate::gpu::pipeline::{
+    UNIFORM, bind_group, bind_group_layout, compute_pipeline, storage_binding, storage_buffer,
+    uniform_buffer,
+};
+
+/// Most particles the GPU holds: the render pass packs a particle's index into 19 bits.
+pub const MAX_PARTICLES: u32 = 1 << 19;
+
+/// Invocations per workgroup of the generation passes.
+const WORKGROUP: u32 = 64;
+
+/// The `Generation` uniform of `particle_generate.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GenerationUniform {
+    sigma_max_per_m: f32,
+    particle_mean_density: f32,
+    reserved0: [u32; 2],
+    rings: u32,
+    ring_cells: u32,
+    cell_layers: u32,
+    inner_cell_m: f32,
+    column_count: u32,
+    max_particles: u32,
+    occlusion_early_exit: u32,
+    reserved: u32,
+}
+
+impl GenerationUniform {
+    fn new(g: &Generation) -> GenerationUniform {
+        GenerationUniform {
+            sigma_max_per_m: g.sigma_max_per_m,
+            particle_mean_density: g.particle_mean_density,
+            reserved0: [0; 2],
+            rings: g.grid.rings,
+            ring_cells: g.grid.ring_cells,
+            cell_layers: g.grid.cell_layers,
+            inner_cell_m: g.grid.inner_cell_m,
+            column_count: g.grid.column_count(),
+            max_particles: capacity(g),
+            occlusion_early_exit: u32::from(g.occlusion_early_exit),
+            reserved: 0,
+        }
+    }
+}
+
+/// Particles the buffers hold for `g`.
+fn capacity(g: &Generation) -> u32 {
+    g.grid.max_particles().min(MAX_PARTICLES)
+}
+
+/// What a frame's generation counted (`counts` in `particle_generate.wgsl`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GenerationCounts {
+    /// Non-empty cells listed.
+    pub cells: u32,
+    /// Particles made (at most the capacity).
+    pub particles: u32,
+    /// Segments of the marches toward the sun.
+    pub occlusion_steps: u32,
+    /// Particles beyond the capacity, dropped.
+    pub dropped: u32,
+}
+
+impl GenerationCounts {
+    /// From the four raw counters.
+    pub fn from_words(words: &[u32]) -> GenerationCounts {
+        GenerationCounts {
+            cells: words[0],
+            particles: words[1].min(MAX_PARTICLES),
+            occlusion_steps: words[2],
+            dropped: words[3],
+        }
+    }
+}
+
+/// The generation passes and their buffers, sized for one grid.
+pub struct ParticleGenerator {
+    slots: SharedSlots,
+    list: wgpu::ComputePipeline,
+    size_cells: wgpu::ComputePipeline,
+    generate: wgpu::ComputePipeline,
+    size_particles: wgpu::ComputePipeline,
+    uniform: wgpu::Buffer,
+    /// The passes' bind group: binding the dispatch sizes, and binding a stand-in for them.
+    groups: [wgpu::BindGroup; 2],
+    /// The four counters (see [`GenerationCounts`]).
+    pub counts: wgpu::Buffer,
+    /// Indirect dispatch sizes: `[0..3]` over the listed cells, `[3..6]` over the particles.
+    pub dispatches: wgpu::Buffer,
+    /// The particles, `Particle` each.
+    pub particles: wgpu::Buffer,
+    capacity: u32,
+    column_count: u32,
+}
+
+impl ParticleGenerator {
+    /// Builds the passes and buffers for the grid of `g`.
+    pub fn new(ctx: &GpuContext, shared: &Shared, g: &Generation) -> ParticleGenerator {
+        let layout = bind_group_layout(
+            &ctx.device,
+            "particle generation",
+            &[
+                UNIFORM,
+                storage_binding(false),
+                storage_binding(false),
+                storage_binding(false),
+                storage_binding(false),
+            ],
+        );
+        let slots = SharedSlots::of("particle_generate");
+        let source = crate::shader::program("particle_generate");
+        let layouts = shared.layouts(slots, &layout);
+        let pipeline = |entry: &str| compute_pipeline(ctx, entry, &source, entry, &layouts);
+        let capacity = capacity(g);
+        let uniform = uniform_buffer(
+            ctx,
+            "particle generation",
+            size_of::<GenerationUniform>() as u64,
+        );
+        let cells = storage_buffer(
+            ctx,
+            "particle cells",
+            u64::from(g.grid.column_count()) * size_of::<ListedCell>() as u64,
+        );
+        let counts = storage_buffer(ctx, "particle counts", 16);
+        let dispatches = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("particle dispatches"),
+            size: 24,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+            mapped_at_creation: false,
+        });
+        let particles = storage_buffer(
+            ctx,
+            "particles",
+            u64::from(capacity) * size_of::<Particle>() as u64,
+        );
+        // An indirect dispatch may not bind its own arguments as writable storage: the
+        // generation pass binds a stand-in instead.
+        let stand_in = storage_buffer(ctx, "particle dispatches stand-in", 24);
+        let group_with = |args: &wgpu::Buffer| {
+            bind_group(
+                &ctx.device,
+                &layout,
+                &[
+                    uniform.as_entire_binding(),
+                    cells.as_entire_binding(),
+                    counts.as_entire_binding(),
+                    args.as_entire_binding(),
+                    particles.as_entire_binding(),
+                ],
+            )
+        };
+        let groups = [group_with(&dispatches), group_with(&stand_in)];
+        ParticleGenerator {
+            slots,
+            list: pipeline("list_cells"),
+            size_cells: pipeline("size_dispatches"),
+            generate: pipeline("generate_particles"),
+            size_particles: pipeline("size_particle_dispatch"),
+            uniform,
+            groups,
+            counts,
+            dispatches,
+            particles,
+            capacity,
+            column_count: g.grid.column_count(),
+        }
+    }
+
+    /// Whether these buffers were sized for the grid of `g`.
+    pub fn fits(&self, g: &Generation) -> bool {
+        self.capacity == capacity(g) && self.column_count == g.grid.column_count()
+    }
+
+    /// Uploads the grid and the particle constants of `g` (the camera and sun are the frame's
+    /// and the environment's).
+    pub fn set(&self, ctx: &GpuContext, g: &Generation) {
+        let uniform = GenerationUniform::new(g);
+        ctx.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+    }
+
+    /// Records the generation passes; `timestamps` time them as one pass.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        shared: &Shared,
+        timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        encoder.clear_buffer(&self.counts, 0, None);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("particle generation"),
+            timestamp_writes: timestamps,
+        });
+        let [sizing, generating] = &self.groups;
+        set_groups(&mut pass, &shared.bind_groups(self.slots, sizing));
+        pass.set_pipeline(&self.list);
+        pass.dispatch_workgroups(self.column_count.div_ceil(WORKGROUP), 1, 1);
+        pass.set_pipeline(&self.size_cells);
+        pass.dispatch_workgroups(1, 1, 1);
+        set_groups(&mut pass, &shared.bind_groups(self.slots, generating));
+        pass.set_pipeline(&self.generate);
+        pass.dispatch_workgroups_indirect(&self.dispatches, 0);
+        set_groups(&mut pass, &shared.bind_groups(self.slots, sizing));
+        pass.set_pipeline(&self.size_particles);
+        pass.dispatch_workgroups(1, 1, 1);
+    }
+
+    /// The particles and counts of the last generation (waits for the GPU): for tests and tools.
+    pub fn read(&self, ctx: &GpuContext) -> (Vec<Particle>, GenerationCounts) {
+        let words: Vec<u32> = crate::gpu::readback::read_buffer(ctx, &self.counts);
+        let counts = GenerationCounts::from_words(&words);
+        let mut particles: Vec<Particle> = crate::gpu::readback::read_buffer(ctx, &self.particles);
+        particles.truncate(counts.particles as usize);
+        (particles, counts)
+    }
+}
+
+/// Binds `groups` at their slots (None: left empty).
+pub fn set_groups(pass: &mut wgpu::ComputePass, groups: &[Option<&wgpu::BindGroup>]) {
+    for (i, g) in groups.iter().enumerate() {
+        if let Some(g) = g {
+            pass.set_bind_group(i as u32, *g, &[]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout_check::assert_wgsl_layout;
+
+    #[test]
+    fn generation_structs_match_their_wgsl_layouts() {
+        assert_wgsl_layout!(
+            "particle_generate",
+            "Generation",
+            GenerationUniform {
+                sigma_max_per_m,
+                particle_mean_density,
+                reserved0,
+                rings,
+                ring_cells,
+                cell_layers,
+                inner_cell_m,
+                column_count,
+                max_particles,
+                occlusion_early_exit,
+                reserved,
+            }
+        );
+        assert_wgsl_layout!(
+            "particle_generate",
+            "Particle",
+            Particle {
+                centre_m,
+                radius_m,
+                height_m,
+                density,
+                sun_optical_depth,
+                id,
+                optical_depth_up,
+                optical_depth_down,
+                ring,
+                reserved,
+            }
+        );
+    }
+}

@@ -1,0 +1,389 @@
+#import frame environment phase particle particle_lookup
+// Particle rendering in compute (particles/render.rs): the particles of particle_generate.wgsl
+// binned into screen tiles (`bin_particles`, one invocation per particle), then one workgroup per
+// tile (`render_tiles`) that sorts the tile's list by distance and blends, per pixel, the segment of
+// the view ray through each particle, shaded from the tables, front to back with Yusov 2014's
+// volume-aware blending (particles/blend.rs is its specification). wgpu has no rasterizer-ordered
+// views, so the ordering the seed gets from pixel synchronisation comes from the sort.
+
+struct Render {
+    grid_size: vec2<u32>,          // output texels
+    tiles: vec2<u32>,              // tiles across and down
+    tile_capacity: u32,            // entries a tile holds
+    blending: u32,                 // Blending::gpu_index: 0 volume-aware, 1 alpha
+    max_particles: u32,            // capacity of the particle buffer
+    flat_planet: u32,              // 1 on a flat planet
+    planet_radius_m: f32,
+    sigma_max_per_m: f32,          // extinction of density 1
+    reference_optical_radius: f32, // sigma R of the particle the tables were baked for
+    albedo: f32,                   // single-scattering albedo
+    phase_lobes: vec4<f32>,        // optics::PhaseLobes::to_gpu
+    table_dims: vec4<u32>,         // optical-depth table (start zen, start az, dir zen, dir az)
+    ambient_scale: f32,            // scale of sky and ground light
+    band_first_tile_row: u32,      // the first tile row this dispatch renders
+    band_rows: vec2<u32>,          // texel rows [x, y) this dispatch writes
+}
+
+struct Particle {
+    centre_m: vec3<f32>,
+    radius_m: f32,
+    height_m: f32,
+    density: f32,
+    sun_optical_depth: f32,
+    id: u32,
+    optical_depth_up: f32,
+    optical_depth_down: f32,
+    ring: u32,
+    reserved: u32,
+}
+
+@group(3) @binding(0) var<uniform> render: Render;
+@group(3) @binding(1) var<storage, read> particles: array<Particle>;
+// particle_generate.wgsl's counts: [1] particles made.
+@group(3) @binding(2) var<storage, read> counts: array<u32, 4>;
+// Bindings 3-7: the tables (particle_lookup.wgsl).
+@group(3) @binding(8) var<storage, read_write> tile_counts: array<atomic<u32>>;
+// Per tile, `tile_capacity` sort keys: quantised log distance << 19 | particle index.
+@group(3) @binding(9) var<storage, read_write> tile_entries: array<u32>;
+@group(3) @binding(10) var host_depth: texture_2d<f32>;
+@group(3) @binding(11) var cloud_out: texture_storage_2d<rgba16float, write>;
+@group(3) @binding(12) var cloud_distance_out: texture_storage_2d<r32float, write>;
+// [0] segments blended, [1] texels written, [2] tile entries dropped (full tiles), [3] particles binned.
+@group(3) @binding(13) var<storage, read_write> render_stats: array<atomic<u32>, 4>;
+
+const TILE: u32 = 16u;
+const MAX_TILE_ENTRIES: u32 = 2048u;
+const INDEX_BITS: u32 = 19u;
+const INDEX_MASK: u32 = 0x7ffffu;
+const DISTANCE_LEVELS: f32 = 8191.0;
+const OPAQUE_TRANSMITTANCE: f32 = 0.01;
+// Occlusion of multiple scattering relative to single (Yusov's released code: exp(-0.25 tau)).
+const MULTIPLE_OCCLUSION: f32 = 0.25;
+const VOLUME_AWARE: u32 = 0u;
+
+// The sort key of a particle whose nearest point is `near_m` away: log2 of the distance over
+// [0.5 m, 362 km] in 13 bits (steps of 0.17 %), then the index.
+fn sort_key(near_m: f32, index: u32) -> u32 {
+    let level = clamp((log2(max(near_m, 0.5)) + 1.0) / 19.5, 0.0, 1.0) * DISTANCE_LEVELS;
+    return (u32(level) << INDEX_BITS) | index;
+}
+
+// Output texel of full-resolution pixel coordinates (the frame's sample grid).
+fn grid_texel(pixel: vec2<f32>) -> vec2<f32> {
+    return (pixel - vec2<f32>(frame.grid_subpixel)) / f32(frame.grid_divisor);
+}
+
+// The output texels the particle may cover, (min.xy, max.xy); min > max when none.
+fn particle_footprint(p: Particle) -> vec4<i32> {
+    let all = vec4<i32>(0, 0, vec2<i32>(render.grid_size) - 1);
+    let r = max(p.radius_m, p.height_m);
+    let to_centre = p.centre_m - frame.camera_position_m;
+    let forward = normalize((frame.world_from_view * vec4<f32>(0.0, 0.0, -1.0, 0.0)).xyz);
+    let along = dot(to_centre, forward);
+    if along < -r {
+        return vec4<i32>(1, 1, 0, 0);
+    }
+    if along < 1.74 * r {
+        return all; // the bounding cube reaches the camera plane: clipped, not dropped
+    }
+    var lo = vec2<f32>(3.0e38);
+    var hi = vec2<f32>(-3.0e38);
+    for (var k = 0u; k < 8u; k++) {
+        let corner = p.centre_m + r * vec3<f32>(f32(k & 1u), f32((k >> 1u) & 1u), f32((k >> 2u) & 1u)) * 2.0 - r;
+        let clip = frame.clip_from_world * vec4<f32>(corner, 1.0);
+        let ndc = clip.xy / clip.w;
+        let pixel = vec2<f32>(0.5 * (ndc.x + 1.0), 0.5 * (1.0 - ndc.y)) * frame.viewport_px;
+        lo = min(lo, grid_texel(pixel));
+        hi = max(hi, grid_texel(pixel));
+    }
+    let first = max(vec2<i32>(floor(lo)) - 1, all.xy);
+    let last = min(vec2<i32>(ceil(hi)) + 1, all.zw);
+    return vec4<i32>(first, last);
+}
+
+@compute @workgroup_size(64)
+fn bin_particles(@builtin(global_invocation_id) id: vec3<u32>) {
+    let count = min(counts[1], render.max_particles);
+    if id.x >= count {
+        return;
+    }
+    let p = particles[id.x];
+    if p.density <= 0.0 {
+        return;
+    }
+    let footprint = particle_footprint(p);
+    if any(footprint.xy > footprint.zw) {
+        return;
+    }
+    let near_m = length(p.centre_m - frame.camera_position_m) - max(p.radius_m, p.height_m);
+    let key = sort_key(near_m, id.x);
+    let first = vec2<u32>(footprint.xy) / TILE;
+    let last = vec2<u32>(footprint.zw) / TILE;
+    for (var ty = first.y; ty <= last.y; ty++) {
+        for (var tx = first.x; tx <= last.x; tx++) {
+            let tile = ty * render.tiles.x + tx;
+            let slot = atomicAdd(&tile_counts[tile], 1u);
+            if slot < render.tile_capacity {
+                tile_entries[tile * render.tile_capacity + slot] = key;
+            } else {
+                atomicAdd(&render_stats[2], 1u);
+            }
+        }
+    }
+    atomicAdd(&render_stats[3], 1u);
+}
+
+var<workgroup> tile_keys: array<u32, MAX_TILE_ENTRIES>;
+var<workgroup> tile_length: u32;
+
+// Sorts the first `size` (a power of two) keys of the tile, ascending: a bitonic network over
+// workgroup memory, each invocation taking every 256th pair.
+fn sort_tile_keys(size: u32, lane: u32) {
+    for (var k = 2u; k <= size; k <<= 1u) {
+        for (var j = k >> 1u; j > 0u; j >>= 1u) {
+            for (var i = lane; i < size; i += TILE * TILE) {
+                let l = i ^ j;
+                if l > i {
+                    let a = tile_keys[i];
+                    let b = tile_keys[l];
+                    if (a > b) == ((i & k) == 0u) {
+                        tile_keys[i] = b;
+                        tile_keys[l] = a;
+                    }
+                }
+            }
+            workgroupBarrier();
+        }
+    }
+}
+
+// The seed's per-pixel record (particles/blend.rs Segment).
+struct Segment {
+    near_m: f32,
+    far_m: f32,
+    optical_depth: f32,
+    colour: vec3<f32>,
+}
+
+fn segment_density(s: Segment) -> f32 {
+    return s.optical_depth / max(s.far_m - s.near_m, 1e-6);
+}
+
+// blend::merge.
+fn merge(a: Segment, b: Segment) -> Segment {
+    var first = a;
+    var second = b;
+    if b.near_m < a.near_m {
+        first = b;
+        second = a;
+    }
+    let rho_first = segment_density(first);
+    let rho_second = segment_density(second);
+    let front_m = min(second.near_m, first.far_m) - first.near_m;
+    let isec_m = max(min(first.far_m, second.far_m) - second.near_m, 0.0);
+    var back = second;
+    var back_m = second.far_m - max(first.far_m, second.near_m);
+    if first.far_m > second.far_m {
+        back = first;
+        back_m = first.far_m - second.far_m;
+    }
+    let t_front = exp(-rho_first * front_m);
+    let rho_isec = rho_first + rho_second;
+    let t_isec = exp(-rho_isec * isec_m);
+    let t_back = exp(-segment_density(back) * back_m);
+    var isec_colour = first.colour;
+    if rho_isec > 0.0 {
+        isec_colour = (first.colour * rho_first + second.colour * rho_second) / rho_isec;
+    }
+    let premultiplied = first.colour * (1.0 - t_front) + isec_colour * (1.0 - t_isec) * t_front + back.colour * (1.0 - t_back) * t_front * t_isec;
+    let t = t_front * t_isec * t_back;
+    var colour = isec_colour;
+    if t < 1.0 {
+        colour = premultiplied / (1.0 - t);
+    }
+    return Segment(first.near_m, max(first.far_m, second.far_m), a.optical_depth + b.optical_depth, colour);
+}
+
+// blend::PixelBlend.
+struct PixelBlend {
+    has_record: bool,
+    record: Segment,
+    radiance: vec3<f32>,
+    transmittance: f32,
+    distance_weighted_m: f32,
+}
+
+fn blend_segment(pixel: ptr<function, PixelBlend>, s: Segment) {
+    let opacity = 1.0 - exp(-s.optical_depth);
+    (*pixel).radiance += (*pixel).transmittance * opacity * s.colour;
+    (*pixel).distance_weighted_m += (*pixel).transmittance * opacity * 0.5 * (s.near_m + s.far_m);
+    (*pixel).transmittance *= 1.0 - opacity;
+}
+
+fn blend_add(pixel: ptr<function, PixelBlend>, s: Segment) {
+    if !(*pixel).has_record {
+        (*pixel).record = s;
+        (*pixel).has_record = true;
+    } else if render.blending == VOLUME_AWARE && s.near_m < (*pixel).record.far_m {
+        (*pixel).record = merge((*pixel).record, s);
+    } else {
+        blend_segment(pixel, (*pixel).record);
+        (*pixel).record = s;
+    }
+}
+
+fn blend_is_opaque(pixel: PixelBlend) -> bool {
+    var t = pixel.transmittance;
+    if pixel.has_record {
+        t *= exp(-pixel.record.optical_depth);
+    }
+    return t < OPAQUE_TRANSMITTANCE;
+}
+
+// The light around the particles of one pixel: sun irradiance, the sky's mean radiance from above
+// and the radiance from below (raymarch.wgsl's MarchLight).
+struct Light {
+    sun: vec3<f32>,
+    sky_above: vec3<f32>,
+    from_below: vec3<f32>,
+    phase: f32,
+}
+
+// The ray's segment through particle `p` within [0, t_max], shaded from the tables; optical depth
+// 0 where it misses. The ellipsoid maps to the unit sphere by dividing by its radii; a chord the
+// camera or the host's depth clips keeps its share of the whole chord's optical depth (uniform
+// density, as the blending assumes).
+fn particle_segment(p: Particle, o: vec3<f32>, d: vec3<f32>, t_max: f32, light: Light) -> Segment {
+    var none = Segment(0.0, 0.0, 0.0, vec3<f32>(0.0));
+    let radii = vec3<f32>(p.radius_m, p.height_m, p.radius_m);
+    let lo = (o - p.centre_m) / radii;
+    let ld = d / radii;
+    let a = dot(ld, ld);
+    let b = dot(lo, ld);
+    let c = dot(lo, lo) - 1.0;
+    let disc = b * b - a * c;
+    if disc <= 0.0 {
+        return none;
+    }
+    let s = sqrt(disc);
+    let t0 = (-b - s) / a;
+    let t1 = (-b + s) / a;
+    let near_m = max(t0, 0.0);
+    let far_m = min(t1, t_max);
+    if far_m <= near_m {
+        return none;
+    }
+    let entry = normalize(lo + t0 * ld);
+    let dir = normalize(ld);
+    let turn = particle_rotation(p.id);
+    let mass = particle_optical_mass(particle_rotate(turn, entry), particle_rotate(turn, dir), render.table_dims);
+    let tau_chord = render.sigma_max_per_m * p.density * mass / sqrt(a);
+    let optical_depth = tau_chord * (far_m - near_m) / (t1 - t0);
+    let to_light = normalize(environment_sun_direction() / radii);
+    let sm = particle_scattering(entry, -dir, to_light);
+    let sun = light.sun * (light.phase * sm.x * exp(-p.sun_optical_depth) + sm.y * exp(-MULTIPLE_OCCLUSION * p.sun_optical_depth));
+    let reference_opacity = max(1.0 - exp(-render.reference_optical_radius * mass), 1e-3);
+    let ambient = 0.5 * render.ambient_scale * (light.sky_above * frame_diffuse_transmittance(p.optical_depth_up) + light.from_below * frame_diffuse_transmittance(p.optical_depth_down));
+    return Segment(near_m, far_m, optical_depth, sun / reference_opacity + render.albedo * ambient);
+}
+
+// Distance to the ground along the ray (3e38 without one): field_ground_distance, for the planet
+// of the Render uniform (this program binds no field).
+fn ground_distance(o: vec3<f32>, d: vec3<f32>) -> f32 {
+    if frame.has_ground == 0u {
+        return 3.0e38;
+    }
+    if render.flat_planet == 1u {
+        return select(3.0e38, -o.y / d.y, d.y < 0.0 && o.y > 0.0);
+    }
+    let r = render.planet_radius_m;
+    let b = dot(o, d) + d.y * r;
+    let c = dot(o, o) + 2.0 * o.y * r;
+    let disc = b * b - c;
+    if disc < 0.0 {
+        return 3.0e38;
+    }
+    let t = -b - sqrt(disc);
+    return select(3.0e38, max(t, 0.0), -b + sqrt(disc) > 0.0);
+}
+
+// The farthest host depth over a block of the full-resolution depth buffer (raymarch.wgsl's
+// march_block_depth): a low-resolution ray must not stop short of geometry only part of it has.
+fn block_depth(block: vec2<u32>, size: u32) -> f32 {
+    var depth = 1.0 - frame.depth_far_value;
+    let full = vec2<u32>(frame.viewport_px);
+    for (var y = 0u; y < size; y++) {
+        for (var x = 0u; x < size; x++) {
+            let texel = min(block * size + vec2<u32>(x, y), full - 1u);
+            depth = frame_farther_depth(depth, textureLoad(host_depth, vec2<i32>(texel), 0).x);
+        }
+    }
+    return depth;
+}
+
+@compute @workgroup_size(16, 16)
+fn render_tiles(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_id) local: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    let tile = vec2<u32>(group.x, group.y + render.band_first_tile_row);
+    let tile_index = tile.y * render.tiles.x + tile.x;
+    if lane == 0u {
+        tile_length = min(atomicLoad(&tile_counts[tile_index]), render.tile_capacity);
+    }
+    let n = workgroupUniformLoad(&tile_length);
+    var size = 1u;
+    while size < n {
+        size <<= 1u;
+    }
+    for (var i = lane; i < size; i += TILE * TILE) {
+        tile_keys[i] = select(0xffffffffu, tile_entries[tile_index * render.tile_capacity + i], i < n);
+    }
+    workgroupBarrier();
+    sort_tile_keys(size, lane);
+
+    let px = tile * TILE + local.xy;
+    if px.x >= render.grid_size.x || px.y < render.band_rows.x || px.y >= render.band_rows.y {
+        return;
+    }
+    let viewport = vec2<u32>(frame.viewport_px);
+    let pixel = vec2<f32>(min(px * frame.grid_divisor + frame.grid_subpixel, viewport - 1u)) + 0.5;
+    let o = frame.camera_position_m;
+    let d = frame_ray_direction(pixel);
+    var t_max = min(frame.far_m, ground_distance(o, d));
+    t_max = min(t_max, frame_depth_distance(pixel, block_depth(px, frame.grid_divisor)));
+    var below = environment_ground_radiance(frame.ground_albedo, o);
+    if frame.has_ground == 0u {
+        below = environment_sky_radiance(vec3<f32>(0.0, -1.0, 0.0));
+    }
+    let light = Light(
+        environment_sun_irradiance(o),
+        environment_sky_mean_radiance_up(o),
+        below,
+        phase_eval(render.phase_lobes, dot(d, environment_sun_direction())),
+    );
+    var blend: PixelBlend;
+    blend.has_record = false;
+    blend.transmittance = 1.0;
+    var segments = 0u;
+    for (var i = 0u; i < n; i++) {
+        if blend_is_opaque(blend) {
+            break;
+        }
+        let s = particle_segment(particles[tile_keys[i] & INDEX_MASK], o, d, t_max, light);
+        if s.optical_depth > 0.0 {
+            blend_add(&blend, s);
+            segments += 1u;
+        }
+    }
+    if blend.has_record {
+        blend_segment(&blend, blend.record);
+    }
+    let coverage = 1.0 - blend.transmittance;
+    let distance_m = select(0.0, blend.distance_weighted_m / coverage, coverage > 0.0);
+    atomicAdd(&render_stats[0], segments);
+    atomicAdd(&render_stats[1], 1u);
+    textureStore(cloud_out, vec2<i32>(px), vec4<f32>(blend.radiance, blend.transmittance));
+    textureStore(cloud_distance_out, vec2<i32>(px), vec4<f32>(distance_m, 0.0, 0.0, 0.0));
+}

@@ -1,0 +1,415 @@
+//! The particle technique (`render.technique = "particles"`, Yusov 2014): particles generated on
+//! the GPU from the cloud field in a camera-centred ring grid ([`super::generate_gpu`]), binned
+//! into screen tiles, sorted per tile and blended per pixel with volume-aware blending, each shaded
+//! from the precomputed tables ([`super::tables_gpu`]). It writes the cloud-output contract at the
+//! sample grid's resolution like every technique, so temporal reuse, upsampling and compositing
+//! serve it unchanged.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{UVec2, Vec3, Vec4};
+
+use super::ParticleTableSpec;
+use super::blend::Blending;
+use super::generate::Generation;
+use super::generate_gpu::{GenerationCounts, MAX_PARTICLES, ParticleGenerator, set_groups};
+use super::grid::RingGrid;
+use super::store::TableStore;
+use super::tables_gpu::ParticleTables;
+use crate::frame::{Shared, SharedSlots};
+use crate::gpu::late_readback::LateReadback;
+use crate::gpu::pipeline::{
+    BindGroupCache, UNFILTERABLE_TEXTURE_2D, UNIFORM, bind_group, bind_group_layout,
+    compute_pipeline, float_texture, storage_binding, storage_buffer, storage_texture_2d,
+    uniform_buffer,
+};
+use crate::gpu::{GpuContext, PassTimer};
+use crate::optics::PhaseLobes;
+use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
+use crate::scene::{PlanetShape, Scene};
+use crate::technique::{Technique, TechniqueStats, TechniqueTargets};
+
+/// Output texels along each side of a screen tile (`TILE` in `particle_render.wgsl`).
+pub const TILE_TEXELS: u32 = 16;
+/// Particles a tile's list holds (`MAX_TILE_ENTRIES`): the sort runs in 8 KiB of workgroup memory.
+pub const TILE_CAPACITY: u32 = 2048;
+
+/// The timed passes of a frame, in order.
+pub const PASS_NAMES: &[&str] = &["particles: generate", "particles: bin", "particles: render"];
+
+/// The `Render` uniform of `particle_render.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct RenderUniform {
+    grid_size: UVec2,
+    tiles: UVec2,
+    tile_capacity: u32,
+    blending: u32,
+    max_particles: u32,
+    flat_planet: u32,
+    planet_radius_m: f32,
+    sigma_max_per_m: f32,
+    reference_optical_radius: f32,
+    albedo: f32,
+    phase_lobes: Vec4,
+    table_dims: [u32; 4],
+    ambient_scale: f32,
+    band_first_tile_row: u32,
+    band_rows: UVec2,
+}
+
+/// What the particle technique counted in a frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ParticleStats {
+    /// Generation's counts.
+    pub generation: GenerationCounts,
+    /// Particle segments blended, over all texels.
+    pub segments: u32,
+    /// Texels written.
+    pub texels: u32,
+    /// Tile entries dropped because a tile's list was full.
+    pub dropped_tile_entries: u32,
+    /// Particles binned into at least one tile (in view).
+    pub binned: u32,
+}
+
+/// The tile lists, sized for one output.
+struct TileLists {
+    tiles: UVec2,
+    counts: wgpu::Buffer,
+    entries: wgpu::Buffer,
+}
+
+impl TileLists {
+    fn new(ctx: &GpuContext, size: UVec2) -> TileLists {
+        let tiles = tile_grid(size);
+        let n = u64::from(tiles.x * tiles.y);
+        TileLists {
+            tiles,
+            counts: storage_buffer(ctx, "particle tile counts", n * 4),
+            entries: storage_buffer(
+                ctx,
+                "particle tile entries",
+                n * u64::from(TILE_CAPACITY) * 4,
+            ),
+        }
+    }
+}
+
+/// Tiles across and down an output of `size` texels.
+fn tile_grid(size: UVec2) -> UVec2 {
+    (size + TILE_TEXELS - 1) / TILE_TEXELS
+}
+
+/// Bytes of the render counters.
+const STATS_BYTES: u64 = 16;
+
+/// The particle technique.
+pub struct ParticleRenderer {
+    slots: SharedSlots,
+    layout: wgpu::BindGroupLayout,
+    bin: wgpu::ComputePipeline,
+    render: wgpu::ComputePipeline,
+    uniform: wgpu::Buffer,
+    settings: RenderUniform,
+    stats: wgpu::Buffer,
+    readback: LateReadback,
+    generation_readback: LateReadback,
+    store: TableStore,
+    tables: Option<ParticleTables>,
+    generation: Option<Generation>,
+    generator: Option<ParticleGenerator>,
+    lists: Option<TileLists>,
+    group: BindGroupCache,
+    generated: bool,
+}
+
+impl ParticleRenderer {
+    /// Builds the passes against the shared groups' layouts; the tables and particle buffers are
+    /// made by the first [`Technique::prepare`] and [`Technique::encode`].
+    pub fn new(ctx: &GpuContext, shared: &Shared) -> ParticleRenderer {
+        let read_only = storage_binding(true);
+        let layout = bind_group_layout(
+            &ctx.device,
+            "particle render",
+            &[
+                UNIFORM,
+                read_only,
+                read_only,
+                float_texture(wgpu::TextureViewDimension::D3),
+                wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                read_only,
+                float_texture(wgpu::TextureViewDimension::D3),
+                wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                storage_binding(false),
+                storage_binding(false),
+                UNFILTERABLE_TEXTURE_2D,
+                storage_texture_2d(CLOUD_FORMAT),
+                storage_texture_2d(CLOUD_DISTANCE_FORMAT),
+                storage_binding(false),
+            ],
+        );
+        let slots = SharedSlots::of("particle_render");
+        let source = crate::shader::program("particle_render");
+        let layouts = shared.layouts(slots, &layout);
+        let pipeline = |entry: &str| compute_pipeline(ctx, entry, &source, entry, &layouts);
+        ParticleRenderer {
+            slots,
+            bin: pipeline("bin_particles"),
+            render: pipeline("render_tiles"),
+            layout,
+            uniform: uniform_buffer(ctx, "particle render", size_of::<RenderUniform>() as u64),
+            settings: RenderUniform::zeroed(),
+            stats: storage_buffer(ctx, "particle render stats", STATS_BYTES),
+            readback: LateReadback::new(ctx, "particle render stats", STATS_BYTES),
+            generation_readback: LateReadback::new(ctx, "particle generation counts", 16),
+            store: TableStore::user_cache(),
+            tables: None,
+            generation: None,
+            generator: None,
+            lists: None,
+            group: BindGroupCache::default(),
+            generated: false,
+        }
+    }
+
+    /// The particle buffers (for tests and tools: read them with [`ParticleGenerator::read`]).
+    pub fn generator(&self) -> Option<&ParticleGenerator> {
+        self.generator.as_ref()
+    }
+
+    /// The counts of the newest frame the GPU has finished (never waits).
+    pub fn particle_stats(&mut self, ctx: &GpuContext) -> Option<ParticleStats> {
+        let generation = GenerationCounts::from_words(bytemuck::cast_slice(
+            self.generation_readback.latest(ctx)?,
+        ));
+        let words: &[u32] = bytemuck::cast_slice(self.readback.latest(ctx)?);
+        Some(ParticleStats {
+            generation,
+            segments: words[0],
+            texels: words[1],
+            dropped_tile_entries: words[2],
+            binned: words[3],
+        })
+    }
+
+    fn load_tables(&mut self, ctx: &GpuContext, scene: &Scene) -> &ParticleTables {
+        let spec = ParticleTableSpec::from_scene(scene);
+        if self.tables.as_ref().is_none_or(|t| t.spec != spec) {
+            self.tables = Some(ParticleTables::new(ctx, &spec, &self.store, &mut |_, _| {}));
+            self.group.clear();
+        }
+        self.tables.as_ref().expect("loaded above")
+    }
+
+    fn uniform(scene: &Scene, tables: &ParticleTables) -> RenderUniform {
+        let spec = &tables.spec;
+        let od = spec.optical_depth;
+        RenderUniform {
+            tile_capacity: TILE_CAPACITY,
+            blending: Blending::from_scene(scene.particles.blending).gpu_index(),
+            max_particles: MAX_PARTICLES,
+            flat_planet: u32::from(scene.planet.shape == PlanetShape::Flat),
+            planet_radius_m: scene.planet.radius_m,
+            sigma_max_per_m: spec.extinction_per_m,
+            reference_optical_radius: spec.extinction_per_m * spec.radius_m,
+            albedo: scene.lighting.albedo,
+            phase_lobes: Vec4::from_array(PhaseLobes::from_scene(&scene.phase).to_gpu()),
+            table_dims: [
+                od.start_zenith,
+                od.start_azimuth,
+                od.dir_zenith,
+                od.dir_azimuth,
+            ],
+            ambient_scale: scene.lighting.ambient_scale,
+            ..RenderUniform::zeroed()
+        }
+    }
+
+    /// Makes the tile lists fit `size` output texels.
+    fn ensure_lists(&mut self, ctx: &GpuContext, size: UVec2) {
+        let tiles = tile_grid(size);
+        if self.lists.as_ref().is_none_or(|l| l.tiles != tiles) {
+            self.lists = Some(TileLists::new(ctx, size));
+            self.group.clear();
+        }
+    }
+
+    /// Generates and bins this frame's particles.
+    fn encode_particles(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        shared: &Shared,
+        group: &wgpu::BindGroup,
+        mut timer: Option<&mut PassTimer>,
+    ) {
+        let generator = self.generator.as_ref().expect("made before encoding");
+        let writes = timer
+            .as_deref_mut()
+            .and_then(|t| t.compute_pass_writes(PASS_NAMES[0]));
+        generator.encode(encoder, shared, writes);
+        let lists = self.lists.as_ref().expect("made before encoding");
+        encoder.clear_buffer(&lists.counts, 0, None);
+        let writes = timer.and_then(|t| t.compute_pass_writes(PASS_NAMES[1]));
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(PASS_NAMES[1]),
+            timestamp_writes: writes,
+        });
+        set_groups(&mut pass, &shared.bind_groups(self.slots, group));
+        pass.set_pipeline(&self.bin);
+        pass.dispatch_workgroups_indirect(&generator.dispatches, 12);
+    }
+}
+
+impl Technique for ParticleRenderer {
+    fn name(&self) -> &'static str {
+        "particles"
+    }
+
+    fn pass_names(&self) -> &'static [&'static str] {
+        PASS_NAMES
+    }
+
+    fn prepare(&mut self, ctx: &GpuContext, scene: &Scene) {
+        let tables = self.load_tables(ctx, scene);
+        let settings = Self::uniform(scene, tables);
+        let environment = crate::environment::Environment::from_scene(scene);
+        let generation = Generation {
+            grid: RingGrid::from_scene(&scene.particles),
+            camera_m: Vec3::from_array(scene.camera.position_m),
+            sun_direction: environment.sun.direction,
+            time_s: scene.render.time_s,
+            sigma_max_per_m: tables.spec.extinction_per_m,
+            particle_mean_density: tables.mean_density,
+            occlusion_early_exit: true,
+        };
+        self.settings = settings;
+        self.generation = Some(generation);
+        self.generated = false;
+    }
+
+    fn encode(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        shared: &Shared,
+        targets: &TechniqueTargets,
+        (origin, size): (UVec2, UVec2),
+        timer: Option<(&mut PassTimer, &str)>,
+    ) {
+        let generation = self.generation.expect("prepare comes before encode");
+        if self.generator.as_ref().is_none_or(|g| !g.fits(&generation)) {
+            self.generator = Some(ParticleGenerator::new(ctx, shared, &generation));
+            self.group.clear();
+        }
+        self.generator
+            .as_ref()
+            .expect("made above")
+            .set(ctx, &generation);
+        let output = targets.output;
+        self.ensure_lists(ctx, output.size);
+        let lists = self.lists.as_ref().expect("made above");
+        let first_row = origin.y / TILE_TEXELS;
+        let rows = (origin.y + size.y).div_ceil(TILE_TEXELS) - first_row;
+        self.settings.grid_size = output.size;
+        self.settings.tiles = lists.tiles;
+        self.settings.band_first_tile_row = first_row;
+        self.settings.band_rows = UVec2::new(origin.y, origin.y + size.y);
+        ctx.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.settings));
+        let (tables, generator) = (
+            self.tables.as_ref().expect("prepare loads the tables"),
+            self.generator.as_ref().expect("made above"),
+        );
+        let (layout, uniform, stats) = (&self.layout, &self.uniform, &self.stats);
+        let views = [targets.host_depth, &output.radiance, &output.distance];
+        let group = self
+            .group
+            .get(&views, || {
+                let od = &tables.optical_depth;
+                let od_view = od.texture.create_view(&Default::default());
+                let sc_view = tables.scattering.texture.create_view(&Default::default());
+                bind_group(
+                    &ctx.device,
+                    layout,
+                    &[
+                        uniform.as_entire_binding(),
+                        generator.particles.as_entire_binding(),
+                        generator.counts.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(&od_view),
+                        wgpu::BindingResource::Sampler(&od.sampler),
+                        od.chord_buffer.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(&sc_view),
+                        wgpu::BindingResource::Sampler(&tables.scattering.sampler),
+                        lists.counts.as_entire_binding(),
+                        lists.entries.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(targets.host_depth),
+                        wgpu::BindingResource::TextureView(&output.radiance),
+                        wgpu::BindingResource::TextureView(&output.distance),
+                        stats.as_entire_binding(),
+                    ],
+                )
+            })
+            .clone();
+        let mut timer = timer.map(|(t, _)| t);
+        if !self.generated {
+            encoder.clear_buffer(&self.stats, 0, None);
+            self.encode_particles(encoder, shared, &group, timer.as_deref_mut());
+            self.generated = true;
+        }
+        let tiles_x = self.lists.as_ref().expect("made above").tiles.x;
+        let writes = timer.and_then(|t| t.compute_pass_writes(PASS_NAMES[2]));
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(PASS_NAMES[2]),
+            timestamp_writes: writes,
+        });
+        set_groups(&mut pass, &shared.bind_groups(self.slots, &group));
+        pass.set_pipeline(&self.render);
+        pass.dispatch_workgroups(tiles_x, rows, 1);
+    }
+
+    fn finish_frame(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        self.readback.copy(encoder, &self.stats);
+        if let Some(g) = &self.generator {
+            self.generation_readback.copy(encoder, &g.counts);
+        }
+    }
+
+    fn stats(&mut self, ctx: &GpuContext) -> Option<TechniqueStats> {
+        let s = self.particle_stats(ctx)?;
+        Some(TechniqueStats {
+            pixels: s.texels,
+            density_samples_per_pixel: f64::from(s.segments) / f64::from(s.texels.max(1)),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout_check::assert_wgsl_layout;
+
+    #[test]
+    fn the_render_uniform_matches_its_wgsl_layout() {
+        assert_wgsl_layout!(
+            "particle_render",
+            "Render",
+            RenderUniform {
+                grid_size,
+                tiles,
+                tile_capacity,
+                blending,
+                max_particles,
+                flat_planet,
+                planet_radius_m,
+                sigma_max_per_m,
+                reference_optical_radius,
+                albedo,
+                phase_lobes,
+                table_dims,
+                ambient_scale,
+                band_first_tile_row,
+                band_rows,
+            }
+        );
+    }
+}
