@@ -38,6 +38,12 @@ pub trait Technique {
     /// The labels its passes are timed under, in the order it records them.
     fn pass_names(&self) -> &'static [&'static str];
 
+    /// The resolution divisor (1, 2 or 4) of its output in frames without temporal reuse; the
+    /// shared upsampling brings it to full resolution.
+    fn still_divisor(&self, _scene: &Scene) -> u32 {
+        1
+    }
+
     /// Takes this frame's settings (steps, lighting, phase function) from `scene`.
     fn prepare(&mut self, ctx: &GpuContext, scene: &Scene);
 

@@ -13,8 +13,8 @@ use crate::gpu::pipeline::{
     uniform_buffer,
 };
 
-/// Most particles the GPU holds: the render pass packs a particle's index into 19 bits.
-pub const MAX_PARTICLES: u32 = 1 << 19;
+/// Most particles the GPU holds: the render pass packs a particle's index into 20 bits.
+pub const MAX_PARTICLES: u32 = 1 << 20;
 
 /// Invocations per workgroup of the generation passes.
 const WORKGROUP: u32 = 64;

@@ -10,7 +10,10 @@
 //! camera's position within a cell ([`RingGrid::weight`]), so the grid does not pop.
 //! `particle_generate.wgsl` is the twin of every function here.
 
-use crate::scene::Particles;
+use crate::scene::Scene;
+
+/// Most particle layers a cell stacks.
+pub const MAX_LAYERS: u32 = 16;
 use glam::{IVec2, Vec2};
 
 /// Largest offset of a particle from its cell's centre, as a fraction of the cell, along each axis
@@ -45,8 +48,11 @@ pub struct Column {
 
 impl RingGrid {
     /// The grid a scene's `[particles]` asks for: its cell size makes the outer ring's fade end
-    /// at `distance_m`.
-    pub fn from_scene(particles: &Particles) -> RingGrid {
+    /// at `distance_m`; `cell_layers = 0` stacks as many layers as make the inner ring's cells
+    /// about as tall as they are wide across the scene's layer band (Yusov's 4 layers over his
+    /// 700 m band of 184 m cells), 1..16.
+    pub fn from_scene(scene: &Scene) -> RingGrid {
+        let particles = &scene.particles;
         let mut grid = RingGrid {
             rings: particles.rings,
             ring_cells: particles.ring_cells,
@@ -54,6 +60,16 @@ impl RingGrid {
             inner_cell_m: 1.0,
         };
         grid.inner_cell_m = particles.distance_m / grid.outer_reach_cells();
+        if grid.cell_layers == 0 {
+            let bottom = scene.layers.iter().map(|l| l.bottom_m).reduce(f32::min);
+            let top = scene
+                .layers
+                .iter()
+                .map(|l| l.bottom_m + l.thickness_m)
+                .reduce(f32::max);
+            let band_m = top.zip(bottom).map_or(0.0, |(t, b)| t - b);
+            grid.cell_layers = ((band_m / grid.inner_cell_m).round() as u32).clamp(1, MAX_LAYERS);
+        }
         grid
     }
 
@@ -153,7 +169,7 @@ mod tests {
     use super::*;
 
     fn grid() -> RingGrid {
-        RingGrid::from_scene(&Particles::default())
+        RingGrid::from_scene(&Scene::default())
     }
 
     #[test]

@@ -43,7 +43,7 @@ struct Particle {
 @group(3) @binding(2) var<storage, read> counts: array<u32, 4>;
 // Bindings 3-7: the tables (particle_lookup.wgsl).
 @group(3) @binding(8) var<storage, read_write> tile_counts: array<atomic<u32>>;
-// Per tile, `tile_capacity` sort keys: quantised log distance << 19 | particle index.
+// Per tile, `tile_capacity` sort keys: quantised log distance << 20 | particle index.
 @group(3) @binding(9) var<storage, read_write> tile_entries: array<u32>;
 @group(3) @binding(10) var host_depth: texture_2d<f32>;
 @group(3) @binding(11) var cloud_out: texture_storage_2d<rgba16float, write>;
@@ -53,16 +53,16 @@ struct Particle {
 
 const TILE: u32 = 16u;
 const MAX_TILE_ENTRIES: u32 = 2048u;
-const INDEX_BITS: u32 = 19u;
-const INDEX_MASK: u32 = 0x7ffffu;
-const DISTANCE_LEVELS: f32 = 8191.0;
+const INDEX_BITS: u32 = 20u;
+const INDEX_MASK: u32 = 0xfffffu;
+const DISTANCE_LEVELS: f32 = 4095.0;
 const OPAQUE_TRANSMITTANCE: f32 = 0.01;
 // Occlusion of multiple scattering relative to single (Yusov's released code: exp(-0.25 tau)).
 const MULTIPLE_OCCLUSION: f32 = 0.25;
 const VOLUME_AWARE: u32 = 0u;
 
 // The sort key of a particle whose nearest point is `near_m` away: log2 of the distance over
-// [0.5 m, 362 km] in 13 bits (steps of 0.17 %), then the index.
+// [0.5 m, 362 km] in 12 bits (steps of 0.33 %), then the index.
 fn sort_key(near_m: f32, index: u32) -> u32 {
     let level = clamp((log2(max(near_m, 0.5)) + 1.0) / 19.5, 0.0, 1.0) * DISTANCE_LEVELS;
     return (u32(level) << INDEX_BITS) | index;
@@ -281,10 +281,15 @@ fn particle_segment(p: Particle, o: vec3<f32>, d: vec3<f32>, t_max: f32, light: 
     let optical_depth = tau_chord * (far_m - near_m) / (t1 - t0);
     let to_light = normalize(environment_sun_direction() / radii);
     let sm = particle_scattering(entry, -dir, to_light);
-    let sun = light.sun * (light.phase * sm.x * exp(-p.sun_optical_depth) + sm.y * exp(-MULTIPLE_OCCLUSION * p.sun_optical_depth));
-    let reference_opacity = max(1.0 - exp(-render.reference_optical_radius * mass), 1e-3);
+    // Per unit opacity of the reference particle along this chord: single scattering at most the
+    // albedo (an unshadowed thin chord), multiple at most 1 / pi (a white Lambertian reflector);
+    // the bounds hold where the tables' grazing texels outlive the vanishing chord.
+    let reference_opacity = max(1.0 - exp(-render.reference_optical_radius * mass), 1e-4);
+    let single = min(sm.x / reference_opacity, render.albedo);
+    let multiple = min(sm.y / reference_opacity, 1.0 / PI);
+    let sun = light.sun * (light.phase * single * exp(-p.sun_optical_depth) + multiple * exp(-MULTIPLE_OCCLUSION * p.sun_optical_depth));
     let ambient = 0.5 * render.ambient_scale * (light.sky_above * frame_diffuse_transmittance(p.optical_depth_up) + light.from_below * frame_diffuse_transmittance(p.optical_depth_down));
-    return Segment(near_m, far_m, optical_depth, sun / reference_opacity + render.albedo * ambient);
+    return Segment(near_m, far_m, optical_depth, sun + render.albedo * ambient);
 }
 
 // Distance to the ground along the ray (3e38 without one): field_ground_distance, for the planet

@@ -269,12 +269,16 @@ impl Technique for ParticleRenderer {
         PASS_NAMES
     }
 
+    fn still_divisor(&self, scene: &Scene) -> u32 {
+        scene.particles.resolution_divisor
+    }
+
     fn prepare(&mut self, ctx: &GpuContext, scene: &Scene) {
         let tables = self.load_tables(ctx, scene);
         let settings = Self::uniform(scene, tables);
         let environment = crate::environment::Environment::from_scene(scene);
         let generation = Generation {
-            grid: RingGrid::from_scene(&scene.particles),
+            grid: RingGrid::from_scene(scene),
             camera_m: Vec3::from_array(scene.camera.position_m),
             sun_direction: environment.sun.direction,
             time_s: scene.render.time_s,

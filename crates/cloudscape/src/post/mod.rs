@@ -4,6 +4,7 @@
 //! made once; bind groups are remade only when the targets change.
 
 pub mod tonemap;
+pub mod upsample;
 
 use crate::frame::{Shared, SharedSlots};
 use crate::gpu::pipeline::{

@@ -14,6 +14,7 @@ use crate::frame::{Frame, FrameGpu, Shared};
 use crate::gpu::pipeline::{STORAGE_OUTPUT, texture_2d};
 use crate::gpu::{GpuContext, PassTimer};
 use crate::output::{CloudOutput, SampleGrid};
+use crate::post::upsample::Upsampler;
 use crate::post::{Background, Compositor, DISPLAY_FORMAT, Display, HDR_FORMAT};
 use crate::scene::Scene;
 use crate::technique::{Technique, TechniqueStats, TechniqueTargets};
@@ -45,6 +46,8 @@ struct Targets {
     size: UVec2,
     grid: SampleGrid,
     output: CloudOutput,
+    /// The upsampled output of a coarse grid without temporal reuse.
+    full: Option<CloudOutput>,
     hdr: wgpu::Texture,
     hdr_view: wgpu::TextureView,
     ldr: wgpu::Texture,
@@ -59,6 +62,7 @@ impl Targets {
             size,
             grid,
             output: CloudOutput::new(ctx, "cloud output", grid.size(size)),
+            full: (grid.divisor > 1).then(|| CloudOutput::new(ctx, "upsampled clouds", size)),
             hdr_view: hdr.create_view(&Default::default()),
             ldr_view: ldr.create_view(&Default::default()),
             hdr,
@@ -76,6 +80,7 @@ pub struct CloudRenderer {
     environment_gpu: EnvironmentGpu,
     technique: Box<dyn Technique>,
     temporal: Option<TemporalResolve>,
+    upsampler: Upsampler,
     compositor: Compositor,
     display: Display,
     targets: Option<Targets>,
@@ -102,6 +107,7 @@ impl CloudRenderer {
         };
         let technique = dispatch::build(ctx, &shared, scene.render.technique)?;
         let compositor = Compositor::new(ctx, &shared);
+        let upsampler = Upsampler::new(ctx, &shared);
         Ok(CloudRenderer {
             field,
             field_gpu,
@@ -109,6 +115,7 @@ impl CloudRenderer {
             environment_gpu,
             technique,
             temporal: None,
+            upsampler,
             compositor,
             display: Display::new(ctx),
             targets: None,
@@ -150,6 +157,15 @@ impl CloudRenderer {
         }
     }
 
+    /// Texels of the technique's output this frame (the frame's size over the grid's divisor).
+    pub fn output_size(&self) -> UVec2 {
+        self.targets
+            .as_ref()
+            .expect("begin_frame makes the targets")
+            .output
+            .size
+    }
+
     /// The technique in use.
     pub fn technique_name(&self) -> &'static str {
         self.technique.name()
@@ -158,7 +174,12 @@ impl CloudRenderer {
     /// The labels of a frame's passes as a [`PassTimer`] records them, in order: the technique's
     /// ([`Technique::pass_names`]), "temporal resolve" (with temporal reuse), "compose", "display".
     pub fn pass_names(&self) -> Vec<&'static str> {
-        let shared = ["temporal resolve", "compose", "display"];
+        let shared = [
+            "temporal resolve",
+            crate::post::upsample::UPSAMPLE_PASS,
+            "compose",
+            "display",
+        ];
         self.technique
             .pass_names()
             .iter()
@@ -182,7 +203,14 @@ impl CloudRenderer {
         }
         let grid = match (reuse, &self.temporal) {
             (Reuse::Temporal(_), Some(t)) => t.grid(frame.frame_index),
-            _ => SampleGrid::FULL,
+            _ => {
+                let divisor = self.technique.still_divisor(scene);
+                SampleGrid {
+                    divisor,
+                    subpixel: UVec2::splat((divisor - 1) / 2),
+                    temporal_offset: None,
+                }
+            }
         };
         let (size, divisor) = (frame.size, grid.divisor);
         if self
@@ -262,7 +290,15 @@ impl CloudRenderer {
                 let timer = timer.as_deref_mut();
                 temporal.encode(ctx, encoder, &shared, (frame, wind), inputs, timer)
             }
-            _ => &t.output,
+            _ => match &t.full {
+                Some(full) => {
+                    let inputs = (&t.output, full, background.depth);
+                    let timed = timer.as_deref_mut();
+                    self.upsampler.encode(ctx, encoder, &shared, inputs, timed);
+                    full
+                }
+                None => &t.output,
+            },
         };
         let timed = timer.as_deref_mut();
         self.compositor.encode(
@@ -286,7 +322,7 @@ impl CloudRenderer {
             .expect("begin_frame makes the targets");
         let clouds = match (self.reuse, &self.temporal) {
             (Reuse::Temporal(_), Some(temporal)) => temporal.latest().unwrap_or(&t.output),
-            _ => &t.output,
+            _ => t.full.as_ref().unwrap_or(&t.output),
         };
         FrameImages {
             clouds,

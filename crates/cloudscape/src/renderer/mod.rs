@@ -22,8 +22,9 @@ use std::time::{Duration, Instant};
 /// Rows of output texels rendered per submission when reporting progress.
 const TILE_ROWS: u32 = 32;
 
-/// GPU passes of one frame at most: the technique's (up to three), the temporal resolve, compose
-/// and display ([`CloudRenderer::pass_names`]); a [`PassTimer`] of this capacity times them all.
+/// GPU passes of one frame at most: the technique's (up to three), the temporal resolve or the
+/// upsampling, compose and display ([`CloudRenderer::pass_names`]); a [`PassTimer`] of this
+/// capacity times them all.
 pub const PASS_COUNT: u32 = 6;
 
 /// The images of one render.
@@ -134,17 +135,18 @@ impl SceneRenderer {
         self.host(ctx, &frame);
         let host = self.host.as_ref().expect("made above");
         self.clouds.begin_frame(ctx, scene, &frame, Reuse::None);
-        for row in (0..size.y).step_by(TILE_ROWS as usize) {
+        let output = self.clouds.output_size();
+        for row in (0..output.y).step_by(TILE_ROWS as usize) {
             let band = (
                 UVec2::new(0, row),
-                UVec2::new(size.x, TILE_ROWS.min(size.y - row)),
+                UVec2::new(output.x, TILE_ROWS.min(output.y - row)),
             );
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             self.clouds
                 .encode_clouds(ctx, &mut encoder, &host.depth, Some(band), None);
             ctx.queue.submit([encoder.finish()]);
             ctx.wait_idle();
-            progress((row + band.1.y) as f32 / size.y as f32);
+            progress((row + band.1.y) as f32 / output.y as f32);
         }
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         self.clouds

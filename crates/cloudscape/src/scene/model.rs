@@ -504,7 +504,8 @@ pub struct Particles {
     /// Cells along each side of a ring, even, 16..512 (Yusov: 136, the inner 128 plus 4 on each
     /// side); rings past the first skip their centre.
     pub ring_cells: u32,
-    /// Particles stacked in each cell across the layer band, 1..16 (Yusov: 4).
+    /// Particles stacked in each cell across the layer band, 0..16 (Yusov: 4 over 700 m); 0 stacks
+    /// as many as make the inner ring's cells about as tall as they are wide.
     pub cell_layers: u32,
     /// Reach of the cell grid from the camera, m, 1000..1e6 (Yusov: 200 km); it sets the cell size.
     pub distance_m: f32,
@@ -544,7 +545,7 @@ impl Default for Particles {
             table_resolution: TableResolution::Standard,
             rings: 5,
             ring_cells: 136,
-            cell_layers: 4,
+            cell_layers: 0,
             distance_m: 200_000.0,
             blending: ParticleBlending::VolumeAware,
             resolution_divisor: 2,

@@ -230,7 +230,7 @@ const SCENE_RULES: &[Rule<Scene>] = &[
     rule("particles.radius_m", Between(10.0, 5000.0), "m", |s| Float(s.particles.radius_m)),
     rule("particles.rings", Between(1.0, 8.0), "", |s| Int(s.particles.rings)),
     rule("particles.ring_cells", Between(16.0, 512.0), "", |s| Int(s.particles.ring_cells)),
-    rule("particles.cell_layers", Between(1.0, 16.0), "", |s| Int(s.particles.cell_layers)),
+    rule("particles.cell_layers", Between(0.0, 16.0), "", |s| Int(s.particles.cell_layers)),
     rule("particles.distance_m", Between(1.0e3, 1.0e6), "m", |s| Float(s.particles.distance_m)),
     rule("particles.resolution_divisor", Between(1.0, 4.0), "", |s| Int(s.particles.resolution_divisor)),
     rule("render.width", AtLeast(1.0), "px", |s| Int(s.render.width)),
