@@ -185,21 +185,25 @@ pub fn generate_cell(field: &CloudField, g: &Generation, cell: ListedCell) -> Ve
             let (p, id) = particle_position(field, g, &column, layer);
             let (weight, density) = weighted_density(field, g, column.ring, p);
             let [_, _, _, size_noise, march_jitter] = id_randoms::<5>(id);
-            let grown = smoothstep(0.0, 1.0, density / FULL_SIZE_DENSITY);
-            let scale = (0.5 + 0.5 * size_noise) * grown.max(0.25);
-            let radius_m = column.cell_m * RADIUS_PER_CELL * scale;
-            let height_m = radius_m
-                .max(0.75 * spacing * scale)
-                .min(0.5 * (top - bottom));
+            let full_scale = 0.5 + 0.5 * size_noise;
+            let grown = smoothstep(0.0, 1.0, density / FULL_SIZE_DENSITY).max(0.25);
+            let size = |scale: f32| {
+                let radius_m = column.cell_m * RADIUS_PER_CELL * scale;
+                let height_m = radius_m.max(0.75 * spacing * scale);
+                (radius_m, height_m.min(0.5 * (top - bottom)))
+            };
+            let (radius_m, height_m) = size(full_scale * grown);
             let altitude = field.planet.altitude_m(p);
             let up = field_up(field, p);
             let ambient = |length_m: f32, dir: Vec3| {
                 let length_m = length_m.max(0.0);
                 field.coarse_extinction_per_m(p + dir * (0.5 * length_m), g.time_s) * length_m
             };
-            // Mass-conserving density: the particle carries its cell's share of the field's mass.
+            // Mass-conserving density: a grown particle carries its cell's share of the field's
+            // mass; in thin cloud it shrinks at that density (so it forms and dissipates by size).
             let cell_volume = column.cell_m * column.cell_m * spacing;
-            let ball = 4.0 / 3.0 * std::f32::consts::PI * radius_m * radius_m * height_m;
+            let (full_radius_m, full_height_m) = size(full_scale);
+            let ball = 4.0 / 3.0 * std::f32::consts::PI * full_radius_m.powi(2) * full_height_m;
             let mass_scale = cell_volume / (ball * g.particle_mean_density);
             Particle {
                 centre_m: p,

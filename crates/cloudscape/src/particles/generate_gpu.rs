@@ -137,7 +137,9 @@ impl ParticleGenerator {
         let dispatches = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("particle dispatches"),
             size: 24,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::INDIRECT
+                | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let particles = storage_buffer(
@@ -215,6 +217,20 @@ impl ParticleGenerator {
         set_groups(&mut pass, &shared.bind_groups(self.slots, sizing));
         pass.set_pipeline(&self.size_particles);
         pass.dispatch_workgroups(1, 1, 1);
+    }
+
+    /// Puts `particles` in the buffers as though generation had made them (at most the capacity).
+    pub fn upload(&self, ctx: &GpuContext, particles: &[Particle]) {
+        let n = particles.len().min(self.capacity as usize);
+        ctx.queue
+            .write_buffer(&self.particles, 0, bytemuck::cast_slice(&particles[..n]));
+        let n = n as u32;
+        let counts = [0, n, 0, 0];
+        ctx.queue
+            .write_buffer(&self.counts, 0, bytemuck::cast_slice(&counts));
+        let dispatches = [0, 1, 1, n.div_ceil(WORKGROUP), 1, 1];
+        ctx.queue
+            .write_buffer(&self.dispatches, 0, bytemuck::cast_slice(&dispatches));
     }
 
     /// The particles and counts of the last generation (waits for the GPU): for tests and tools.

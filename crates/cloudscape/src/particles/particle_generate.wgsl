@@ -238,6 +238,12 @@ fn ambient_optical_depth(p: vec3<f32>, length_m: f32, dir: vec3<f32>) -> f32 {
     return field_extinction_coarse(p + dir * (0.5 * l)) * l;
 }
 
+// (radius, height) of a particle of `scale` (generate_cell's `size`).
+fn particle_size(cell_m: f32, spacing: f32, thickness: f32, scale: f32) -> vec2<f32> {
+    let radius_m = cell_m * RADIUS_PER_CELL * scale;
+    return vec2<f32>(radius_m, min(max(radius_m, 0.75 * spacing * scale), 0.5 * thickness));
+}
+
 // generate_cell.
 @compute @workgroup_size(64)
 fn generate_particles(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -256,14 +262,16 @@ fn generate_particles(@builtin(global_invocation_id) id: vec3<u32>) {
         let p = at.xyz;
         let pid = bitcast<u32>(at.w);
         let wd = weighted_density(column.ring, p);
-        let grown = smoothstep(0.0, 1.0, wd.y / FULL_SIZE_DENSITY);
-        let scale = (0.5 + 0.5 * id_random(pid, 4u)) * max(grown, 0.25);
-        let radius_m = column.cell_m * RADIUS_PER_CELL * scale;
-        let height_m = min(max(radius_m, 0.75 * spacing * scale), 0.5 * thickness);
+        let full_scale = 0.5 + 0.5 * id_random(pid, 4u);
+        let grown = max(smoothstep(0.0, 1.0, wd.y / FULL_SIZE_DENSITY), 0.25);
+        let size = particle_size(column.cell_m, spacing, thickness, full_scale * grown);
+        let full = particle_size(column.cell_m, spacing, thickness, full_scale);
+        let radius_m = size.x;
+        let height_m = size.y;
         let altitude = field_altitude_m(p);
         let up = field_up(p);
         let cell_volume = column.cell_m * column.cell_m * spacing;
-        let ball = 4.0 / 3.0 * PI * radius_m * radius_m * height_m;
+        let ball = 4.0 / 3.0 * PI * full.x * full.x * full.y;
         let mass_scale = cell_volume / (ball * generation.particle_mean_density);
         let sun = sun_optical_depth(p, radius_m, id_random(pid, 5u));
         atomicAdd(&counts[COUNT_OCCLUSION_STEPS], u32(sun.y));

@@ -10,7 +10,7 @@ use glam::{UVec2, Vec3, Vec4};
 
 use super::ParticleTableSpec;
 use super::blend::Blending;
-use super::generate::Generation;
+use super::generate::{Generation, Particle};
 use super::generate_gpu::{GenerationCounts, MAX_PARTICLES, ParticleGenerator, set_groups};
 use super::grid::RingGrid;
 use super::store::TableStore;
@@ -121,6 +121,8 @@ pub struct ParticleRenderer {
     lists: Option<TileLists>,
     group: BindGroupCache,
     generated: bool,
+    supplied: Option<Vec<Particle>>,
+    early_exit: bool,
 }
 
 impl ParticleRenderer {
@@ -169,7 +171,21 @@ impl ParticleRenderer {
             lists: None,
             group: BindGroupCache::default(),
             generated: false,
+            supplied: None,
+            early_exit: true,
         }
+    }
+
+    /// Renders `particles` instead of generating them from the field (None: generate again): a
+    /// host's own particle set, and how tests place particles.
+    pub fn set_particles(&mut self, particles: Option<Vec<Particle>>) {
+        self.supplied = particles;
+    }
+
+    /// Whether the march toward the sun stops once the light is below 1 % (on by default; off
+    /// to measure what the early exit saves).
+    pub fn set_occlusion_early_exit(&mut self, on: bool) {
+        self.early_exit = on;
     }
 
     /// The particle buffers (for tests and tools: read them with [`ParticleGenerator::read`]).
@@ -243,10 +259,12 @@ impl ParticleRenderer {
         mut timer: Option<&mut PassTimer>,
     ) {
         let generator = self.generator.as_ref().expect("made before encoding");
-        let writes = timer
-            .as_deref_mut()
-            .and_then(|t| t.compute_pass_writes(PASS_NAMES[0]));
-        generator.encode(encoder, shared, writes);
+        if self.supplied.is_none() {
+            let writes = timer
+                .as_deref_mut()
+                .and_then(|t| t.compute_pass_writes(PASS_NAMES[0]));
+            generator.encode(encoder, shared, writes);
+        }
         let lists = self.lists.as_ref().expect("made before encoding");
         encoder.clear_buffer(&lists.counts, 0, None);
         let writes = timer.and_then(|t| t.compute_pass_writes(PASS_NAMES[1]));
@@ -284,7 +302,7 @@ impl Technique for ParticleRenderer {
             time_s: scene.render.time_s,
             sigma_max_per_m: tables.spec.extinction_per_m,
             particle_mean_density: tables.mean_density,
-            occlusion_early_exit: true,
+            occlusion_early_exit: self.early_exit,
         };
         self.settings = settings;
         self.generation = Some(generation);
@@ -305,10 +323,13 @@ impl Technique for ParticleRenderer {
             self.generator = Some(ParticleGenerator::new(ctx, shared, &generation));
             self.group.clear();
         }
-        self.generator
-            .as_ref()
-            .expect("made above")
-            .set(ctx, &generation);
+        let generator = self.generator.as_ref().expect("made above");
+        generator.set(ctx, &generation);
+        if let Some(particles) = &self.supplied {
+            if !self.generated {
+                generator.upload(ctx, particles);
+            }
+        }
         let output = targets.output;
         self.ensure_lists(ctx, output.size);
         let lists = self.lists.as_ref().expect("made above");
