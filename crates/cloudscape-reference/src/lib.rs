@@ -6,7 +6,9 @@
 //!   [`majorant::MajorantGrid`] of conservative bounds;
 //! - [`integrator::PathTracer`]: next-event estimation toward the sun disc and the sky, exact
 //!   phase sampling, Russian roulette, Lambertian ground;
-//! - [`render::ProgressiveRender`]: passes over all cores, deterministic per seed, stoppable.
+//! - [`render::ProgressiveRender`]: passes over all cores, deterministic per seed, stoppable;
+//! - [`particle_set_medium::ParticleSetMedium`]: the particle technique's own particles as a
+//!   medium (Yusov 2014), path traced by [`PathTracer::for_particle_set`].
 //!
 //! ```no_run
 //! use cloudscape::scene::SceneDocument;
@@ -29,6 +31,7 @@ pub mod light_tracer;
 pub mod majorant;
 pub mod medium;
 pub mod particle_medium;
+pub mod particle_set_medium;
 pub mod render;
 pub mod rng;
 pub mod sampling;
@@ -37,5 +40,6 @@ pub mod tracking;
 
 pub use cloud_medium::CloudMedium;
 pub use integrator::PathTracer;
+pub use particle_set_medium::ParticleSetMedium;
 pub use render::{PixelEstimate, ProgressiveRender, RenderStats};
 pub use scene::DEFAULT_MAJORANT_CELLS;

@@ -1,13 +1,19 @@
-//! A path tracer for a whole scene: the scene's cloud field, camera, sun, sky, ground, phase
-//! function and albedo, just as the GPU techniques get them.
+//! Path tracers for a whole scene: the scene's camera, sun, sky, ground, phase function and
+//! albedo, just as the GPU techniques get them, around the scene's cloud field
+//! ([`PathTracer::for_scene`]) or around a set of the particle technique's particles
+//! ([`PathTracer::for_particle_set`]).
 
 use crate::cloud_medium::CloudMedium;
 use crate::environment::Environment;
 use crate::integrator::PathTracer;
+use crate::medium::Medium;
+use crate::particle_set_medium::ParticleSetMedium;
 use crate::tracking::TrackedMedium;
-use cloudscape::field::{CloudField, FieldError};
+use cloudscape::field::{CloudField, FieldError, PlanetGeometry};
 use cloudscape::frame::Frame;
 use cloudscape::optics::PhaseLobes;
+use cloudscape::particles::density::ReferenceParticle;
+use cloudscape::particles::generate::Particle;
 use cloudscape::scene::Scene;
 use glam::UVec2;
 use std::path::Path;
@@ -34,18 +40,67 @@ impl PathTracer<CloudMedium> {
         if !field.layers.is_empty() {
             field.bake_noise();
         }
+        let planet = field.planet;
+        Ok(PathTracer::in_scene(
+            scene,
+            size,
+            planet,
+            majorant_cells,
+            |frame| {
+                let reach_m = frame.far_m.min(MAX_GRID_REACH_M);
+                CloudMedium::new(field, frame.time_s, frame.camera_position_m, reach_m)
+            },
+        ))
+    }
+}
+
+impl PathTracer<ParticleSetMedium> {
+    /// The path tracer of `scene` at `size` pixels with `particles` in place of the scene's cloud
+    /// field: the same camera, sun, sky, ground, planet, phase function and albedo as
+    /// [`PathTracer::for_scene`], the cloud being the particle technique's own particles, each an
+    /// ellipsoid of `reference` of peak extinction `sigma_max_per_m * density` (Yusov 2014; see
+    /// [`ParticleSetMedium`]). The scene's reference particle and extinction are those of
+    /// `cloudscape::particles::ParticleTableSpec::from_scene`. Builds a majorant grid of about
+    /// `majorant_cells` cells over the particles' bounds (see [`DEFAULT_MAJORANT_CELLS`]).
+    pub fn for_particle_set(
+        scene: &Scene,
+        size: UVec2,
+        particles: &[Particle],
+        reference: ReferenceParticle,
+        sigma_max_per_m: f32,
+        majorant_cells: usize,
+    ) -> PathTracer<ParticleSetMedium> {
+        let planet = PlanetGeometry {
+            shape: scene.planet.shape,
+            radius_m: scene.planet.radius_m,
+        };
+        PathTracer::in_scene(scene, size, planet, majorant_cells, |_| {
+            ParticleSetMedium::new(particles, reference, sigma_max_per_m)
+        })
+    }
+}
+
+impl<M: Medium> PathTracer<M> {
+    /// The path tracer of `scene` at `size` pixels over `planet` around the medium `medium` makes
+    /// for the scene's frame, with a majorant grid of about `majorant_cells` cells.
+    fn in_scene(
+        scene: &Scene,
+        size: UVec2,
+        planet: PlanetGeometry,
+        majorant_cells: usize,
+        medium: impl FnOnce(&Frame) -> M,
+    ) -> PathTracer<M> {
         let frame = Frame::from_scene(scene, size);
         let light = cloudscape::environment::Environment::from_scene(scene);
-        let environment = Environment::new(&frame, &light, field.planet);
-        let reach_m = frame.far_m.min(MAX_GRID_REACH_M);
-        let medium = CloudMedium::new(field, frame.time_s, frame.camera_position_m, reach_m);
-        Ok(PathTracer {
+        let environment = Environment::new(&frame, &light, planet);
+        let medium = medium(&frame);
+        PathTracer {
             volume: TrackedMedium::new(medium, majorant_cells),
             phase: PhaseLobes::from_scene(&scene.phase),
             albedo: scene.lighting.albedo,
             environment,
             frame,
             max_scattering_orders: crate::integrator::MAX_SCATTERING_EVENTS,
-        })
+        }
     }
 }

@@ -16,8 +16,11 @@ use glam::UVec2;
 pub struct TechniqueStats {
     /// Output texels written.
     pub pixels: u32,
-    /// Extinction evaluations along view rays per texel (zero for techniques that do not march).
+    /// Extinction evaluations along view rays per texel (for particles: particle segments
+    /// blended per texel).
     pub density_samples_per_pixel: f64,
+    /// Primitives drawn (particles, sprites); None for techniques without them.
+    pub primitives: Option<u32>,
 }
 
 /// Where a technique reads and writes.

@@ -179,8 +179,9 @@ fn light_occlusion_darkens_low_particles_and_its_early_exit_only_skips_opaque_pa
     let frame = Frame::from_scene(&scene, UVec2::new(96, 64));
     harness.render(&ctx, &scene, &frame);
     let (with_exit, counts_with) = harness.generated(&ctx);
-    harness.particles.set_occlusion_early_exit(false);
-    harness.render(&ctx, &scene, &frame);
+    let mut without = scene.clone();
+    without.particles.occlusion_early_exit = false;
+    harness.render(&ctx, &without, &frame);
     let (without_exit, counts_without) = harness.generated(&ctx);
     assert!(
         counts_with.occlusion_steps < counts_without.occlusion_steps,

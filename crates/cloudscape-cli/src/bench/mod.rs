@@ -32,6 +32,10 @@ pub struct BenchArgs {
     /// [default: none; with --flythrough 4].
     #[arg(long, value_name = "N", value_parser = parse_divisor)]
     temporal: Option<u32>,
+    /// Time each of these techniques in turn on the same scene, e.g. `raymarch,particles`, and
+    /// give their frame times relative to the first [default: the scene's].
+    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+    techniques: Vec<String>,
     #[command(flatten)]
     flythrough: flythrough::FlythroughArgs,
     #[command(flatten)]
@@ -62,6 +66,7 @@ impl Stat {
 
 #[derive(Serialize)]
 struct Report {
+    technique: String,
     adapter: String,
     width: u32,
     height: u32,
@@ -71,8 +76,11 @@ struct Report {
     software: bool,
     passes: Vec<Stat>,
     frame_wall: Stat,
-    /// Extinction evaluations along view rays per pixel (the last frame).
+    /// Extinction evaluations along view rays per pixel (the last frame; for particles,
+    /// particle segments blended per pixel).
     density_samples_per_pixel: f64,
+    /// Particles (or other primitives) drawn in the last frame.
+    primitives: Option<u32>,
 }
 
 /// Runs the fly-through measurement with `--flythrough`, the repeated-frame timing otherwise.
@@ -84,40 +92,77 @@ pub fn run(args: BenchArgs) -> Result<()> {
     }
 }
 
-/// Renders the scene's frame repeatedly, with the jitter advancing, and reports timings.
+/// Times every technique asked for (the scene's by default) one after the other in this run, and
+/// prints each one's report and their frame times relative to the first.
 fn run_repeated(args: BenchArgs) -> Result<()> {
+    let overrides: Vec<Vec<String>> = if args.techniques.is_empty() {
+        vec![Vec::new()]
+    } else {
+        let set = |t: &String| vec![format!("render.technique={t}")];
+        args.techniques.iter().map(set).collect()
+    };
+    let first = args.scene.load(&overrides[0])?;
+    let ctx = args.gpu.open(&first)?;
+    let reports = overrides
+        .iter()
+        .map(|extra| time_frames(&args, &ctx, extra))
+        .collect::<Result<Vec<Report>>>()?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&reports)?);
+        return Ok(());
+    }
+    for report in &reports {
+        print_report(report);
+    }
+    if reports.len() > 1 {
+        let base = reports[0].frame_wall.median_ms;
+        println!(
+            "median frame wall time relative to {}:",
+            reports[0].technique
+        );
+        for r in &reports {
+            println!("  {:<12} {:.3}", r.technique, r.frame_wall.median_ms / base);
+        }
+    }
+    Ok(())
+}
+
+/// Renders the scene (with `extra` overrides) repeatedly, with the jitter advancing, and reports
+/// timings.
+fn time_frames(args: &BenchArgs, ctx: &GpuContext, extra: &[String]) -> Result<Report> {
     let frames = args.frames.unwrap_or(30);
-    let doc = args.scene.load(&[])?;
+    let doc = args.scene.load(extra)?;
     let scene = &doc.scene;
-    let ctx = args.gpu.open(&doc)?;
-    let mut renderer = SceneRenderer::new(&ctx, scene, &doc.resolve_path(""))
+    let mut renderer = SceneRenderer::new(ctx, scene, &doc.resolve_path(""))
         .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
     let mut frame = Frame::from_scene(scene, UVec2::new(scene.render.width, scene.render.height));
-    let mut timer = PassTimer::new(&ctx, PASS_COUNT);
+    let mut timer = PassTimer::new(ctx, PASS_COUNT);
     let names = renderer.pass_names();
     let reuse = args.temporal.map_or(Reuse::None, temporal_reuse);
     let mut pass_ms: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
     let mut wall_ms = Vec::new();
     for i in 0..args.warmup + frames {
         frame.frame_index = i;
-        let wall = renderer.render_frame(&ctx, scene, &frame, reuse, &mut timer);
+        let wall = renderer.render_frame(ctx, scene, &frame, reuse, &mut timer);
         if i < args.warmup {
             continue;
         }
         wall_ms.push(wall.as_secs_f64() * 1e3);
-        for (label, ms) in timer.read_ms(&ctx) {
+        for (label, ms) in timer.read_ms(ctx) {
             if let Some(k) = names.iter().position(|p| *p == label) {
                 pass_ms[k].push(ms);
             }
         }
     }
-    let report = Report {
+    let stats = renderer.stats(ctx);
+    Ok(Report {
+        technique: scene.render.technique.name().to_string(),
         adapter: ctx.summary(),
         width: frame.size.x,
         height: frame.size.y,
         frames,
         timestamps: ctx.has_timestamps(),
-        software: is_software(&ctx),
+        software: is_software(ctx),
         passes: names
             .iter()
             .zip(pass_ms)
@@ -125,11 +170,9 @@ fn run_repeated(args: BenchArgs) -> Result<()> {
             .map(|(n, s)| Stat::new(n, s))
             .collect(),
         frame_wall: Stat::new("frame (wall)", wall_ms),
-        density_samples_per_pixel: renderer
-            .stats(&ctx)
-            .map_or(0.0, |s| s.density_samples_per_pixel),
-    };
-    print_report(&report, args.json)
+        density_samples_per_pixel: stats.map_or(0.0, |s| s.density_samples_per_pixel),
+        primitives: stats.and_then(|s| s.primitives),
+    })
 }
 
 /// Whether the adapter is a CPU (software) one, whose timestamp queries do not time shaders.
@@ -137,14 +180,10 @@ fn is_software(ctx: &GpuContext) -> bool {
     ctx.adapter_info().device_type == wgpu::DeviceType::Cpu
 }
 
-fn print_report(report: &Report, json: bool) -> Result<()> {
-    if json {
-        println!("{}", serde_json::to_string_pretty(report)?);
-        return Ok(());
-    }
+fn print_report(report: &Report) {
     println!(
-        "{} at {}x{}, {} frames",
-        report.adapter, report.width, report.height, report.frames
+        "{} on {} at {}x{}, {} frames",
+        report.technique, report.adapter, report.width, report.height, report.frames
     );
     if !report.timestamps {
         println!("(this adapter has no timestamp queries: GPU time per pass is not available)");
@@ -154,16 +193,18 @@ fn print_report(report: &Report, json: bool) -> Result<()> {
         );
     }
     println!(
-        "{:<14} {:>10} {:>10} {:>10}",
+        "{:<22} {:>10} {:>10} {:>10}",
         "pass", "mean ms", "median ms", "min ms"
     );
     for s in report.passes.iter().chain([&report.frame_wall]) {
         println!(
-            "{:<14} {:>10.3} {:>10.3} {:>10.3}",
+            "{:<22} {:>10.3} {:>10.3} {:>10.3}",
             s.name, s.mean_ms, s.median_ms, s.min_ms
         );
     }
     let samples = report.density_samples_per_pixel;
-    println!("view-ray density samples per pixel: {samples:.1}");
-    Ok(())
+    match report.primitives {
+        Some(n) => println!("particles: {n}; particle segments blended per pixel: {samples:.1}"),
+        None => println!("view-ray density samples per pixel: {samples:.1}"),
+    }
 }

@@ -122,7 +122,6 @@ pub struct ParticleRenderer {
     group: BindGroupCache,
     generated: bool,
     supplied: Option<Vec<Particle>>,
-    early_exit: bool,
 }
 
 impl ParticleRenderer {
@@ -172,7 +171,6 @@ impl ParticleRenderer {
             group: BindGroupCache::default(),
             generated: false,
             supplied: None,
-            early_exit: true,
         }
     }
 
@@ -180,12 +178,6 @@ impl ParticleRenderer {
     /// host's own particle set, and how tests place particles.
     pub fn set_particles(&mut self, particles: Option<Vec<Particle>>) {
         self.supplied = particles;
-    }
-
-    /// Whether the march toward the sun stops once the light is below 1 % (on by default; off
-    /// to measure what the early exit saves).
-    pub fn set_occlusion_early_exit(&mut self, on: bool) {
-        self.early_exit = on;
     }
 
     /// The particle buffers (for tests and tools: read them with [`ParticleGenerator::read`]).
@@ -302,7 +294,7 @@ impl Technique for ParticleRenderer {
             time_s: scene.render.time_s,
             sigma_max_per_m: tables.spec.extinction_per_m,
             particle_mean_density: tables.mean_density,
-            occlusion_early_exit: self.early_exit,
+            occlusion_early_exit: scene.particles.occlusion_early_exit,
         };
         self.settings = settings;
         self.generation = Some(generation);
@@ -404,6 +396,7 @@ impl Technique for ParticleRenderer {
         Some(TechniqueStats {
             pixels: s.texels,
             density_samples_per_pixel: f64::from(s.segments) / f64::from(s.texels.max(1)),
+            primitives: Some(s.generation.particles),
         })
     }
 }

@@ -275,6 +275,7 @@ impl Technique for RaymarchRenderer {
         Some(TechniqueStats {
             pixels,
             density_samples_per_pixel: f64::from(samples) / f64::from(pixels.max(1)),
+            primitives: None,
         })
     }
 }

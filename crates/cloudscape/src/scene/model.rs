@@ -513,6 +513,9 @@ pub struct Particles {
     pub blending: ParticleBlending,
     /// Particles render at 1/divisor of the image resolution: 1, 2 or 4 (Yusov: 2).
     pub resolution_divisor: u32,
+    /// Stop each particle's march toward the sun once its light is below 1 % (Yusov's early
+    /// exit); off only to measure what it saves.
+    pub occlusion_early_exit: bool,
 }
 
 /// How the particle technique blends particles that overlap along a view ray.
@@ -549,6 +552,7 @@ impl Default for Particles {
             distance_m: 200_000.0,
             blending: ParticleBlending::VolumeAware,
             resolution_divisor: 2,
+            occlusion_early_exit: true,
         }
     }
 }
