@@ -4,6 +4,8 @@
 //! Path-traced references are kept in a cache directory keyed by the scene, the size, the sample
 //! count and the seed, so tuning the ray marcher reruns only the GPU side.
 
+mod particles;
+
 use crate::common::{GpuArgs, SceneArgs};
 use crate::compare::Comparison;
 use crate::reference::deadline_after;
@@ -16,6 +18,7 @@ use cloudscape::image::{HdrImage, write_image};
 use cloudscape::renderer::SceneRenderer;
 use cloudscape::scene::{Scene, SceneDocument};
 use cloudscape::temporal::halton;
+use cloudscape_reference::medium::Medium;
 use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer, ProgressiveRender};
 use glam::{UVec2, Vec3};
 use std::fmt::Write as _;
@@ -119,6 +122,7 @@ struct Row {
     samples_per_second: f64,
     spp: f64,
     gpu_ms: f64,
+    particles: Option<particles::ParticleRow>,
 }
 
 /// Renders and compares every canonical scene, then writes the report.
@@ -195,6 +199,8 @@ fn scene_row(
         noise_floor.flip_mean,
         noise_floor.relative_mse
     );
+    let key = cache_key(doc, args)?;
+    let particles = particles::row(canonical.name, doc, ctx, (args, &key), (&full, images))?;
     Ok(Row {
         name: canonical.name,
         title: canonical.title,
@@ -203,6 +209,7 @@ fn scene_row(
         samples_per_second: reference.samples_per_second,
         spp: reference.spp,
         gpu_ms,
+        particles,
     })
 }
 
@@ -213,10 +220,31 @@ struct Reference {
     spp: f64,
 }
 
-/// The path-traced references, from the cache when this scene, size, sample count and seed were
-/// traced before; otherwise traced (half the samples with each of two seeds) and cached.
+/// The path-traced references of the scene's cloud field, from the cache when this scene, size,
+/// sample count and seed were traced before; otherwise traced (half the samples with each of two
+/// seeds) and cached.
 fn cached_reference(doc: &SceneDocument, args: &ReportArgs) -> Result<Reference> {
     let key = cache_key(doc, args)?;
+    let size = UVec2::new(doc.scene.render.width, doc.scene.render.height);
+    cached_trace(&key, size, args, || {
+        PathTracer::for_scene(
+            &doc.scene,
+            &doc.resolve_path(""),
+            size,
+            DEFAULT_MAJORANT_CELLS,
+        )
+        .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))
+    })
+}
+
+/// The references cached under `key`, or traced at `size` with the path tracer `tracer` makes
+/// and cached.
+fn cached_trace<M: Medium>(
+    key: &str,
+    size: UVec2,
+    args: &ReportArgs,
+    tracer: impl FnOnce() -> Result<PathTracer<M>>,
+) -> Result<Reference> {
     let paths = [0, 1].map(|h| args.cache.join(format!("{key}-{h}.exr")));
     let stats_path = args.cache.join(format!("{key}.txt"));
     if let (Ok(a), Ok(b), Ok(stats)) = (
@@ -234,14 +262,7 @@ fn cached_reference(doc: &SceneDocument, args: &ReportArgs) -> Result<Reference>
             spp,
         });
     }
-    let size = UVec2::new(doc.scene.render.width, doc.scene.render.height);
-    let tracer = PathTracer::for_scene(
-        &doc.scene,
-        &doc.resolve_path(""),
-        size,
-        DEFAULT_MAJORANT_CELLS,
-    )
-    .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
+    let tracer = tracer()?;
 
     let (mut samples, mut seconds) = (0u64, 0.0);
     let halves = [0u64, 1].map(|h| {
@@ -325,6 +346,7 @@ const PATH_TRACED_KEYS: [(&str, &[&str]); 2] = [
 /// `scene` as a TOML table without the settings only the real-time techniques read.
 fn path_traced_part(scene: &Scene) -> Result<toml::Table> {
     let mut table = toml::Table::try_from(scene)?;
+    table.remove("particles");
     for (section, kept) in PATH_TRACED_KEYS {
         if let Some(toml::Value::Table(t)) = table.get_mut(section) {
             t.retain(|key, _| kept.contains(&key));
@@ -441,6 +463,7 @@ fn markdown(rows: &[Row], args: &ReportArgs, adapter: &str) -> String {
             r.gpu_ms
         );
     }
+    particles::markdown(&mut s, rows.iter().map(|r| (r.title, &r.particles)));
     let _ = writeln!(
         s,
         "\n## Images\n\nRay marcher | path tracer | HDR-FLIP error (magma)\n"
@@ -449,7 +472,9 @@ fn markdown(rows: &[Row], args: &ReportArgs, adapter: &str) -> String {
         let _ = writeln!(
             s,
             "### {}\n\n| ray marcher | path tracer | HDR-FLIP |\n|---|---|---|\n\
-             | ![](realism/{n}-raymarch.png) | ![](realism/{n}-reference.png) | ![](realism/{n}-flip.png) |\n",
+             | ![](realism/{n}-raymarch.png) | ![](realism/{n}-reference.png) | ![](realism/{n}-flip.png) |\n\n\
+             | particles | path-traced particles | HDR-FLIP of particles |\n|---|---|---|\n\
+             | ![](realism/{n}-particles.png) | ![](realism/{n}-particle-reference.png) | ![](realism/{n}-particles-flip.png) |\n",
             r.title,
             n = r.name
         );
