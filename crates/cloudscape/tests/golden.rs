@@ -107,6 +107,42 @@ fn voxel_grid_cloud_with_henyey_greenstein_and_agx() {
     check("voxel_cloud", &image);
 }
 
+/// The particle technique over the default scene from the ground, at its default half
+/// resolution (covering the shared upsampling), and with alpha blending for comparison.
+#[test]
+fn particles_from_the_ground() {
+    let particles = [
+        "render.technique=particles",
+        "particles.table_resolution=low",
+    ];
+    check("particles_ground", &render("", Path::new("."), &particles));
+    let alpha = [&particles[..], &["particles.blending=alpha"]].concat();
+    check(
+        "particles_ground_alpha",
+        &render("", Path::new("."), &alpha),
+    );
+}
+
+/// The particle technique from above the layer and from inside a cloud (particles clipped at
+/// the camera, not dropped).
+#[test]
+fn particles_from_above_and_inside() {
+    let particles = [
+        "render.technique=particles",
+        "particles.table_resolution=low",
+    ];
+    let above = ["camera.position_m=[0,6500,0]", "camera.pitch_deg=-35"];
+    check(
+        "particles_above",
+        &render("", Path::new("."), &[&particles[..], &above].concat()),
+    );
+    let inside = ["camera.position_m=[4000,2300,-3000]", "camera.pitch_deg=3"];
+    check(
+        "particles_inside",
+        &render("", Path::new("."), &[&particles[..], &inside].concat()),
+    );
+}
+
 /// The goldens directory exists (a typo in the path would make every golden missing).
 #[test]
 fn goldens_directory_exists() {

@@ -128,6 +128,19 @@ fn gpu_particles_match_their_cpu_specification() {
     );
     assert_eq!(counts.particles as usize, gpu.len());
     assert_eq!(counts.dropped, 0);
+    ctx.wait_idle();
+    let stats = harness
+        .particles
+        .particle_stats(&ctx)
+        .expect("a finished frame");
+    assert_eq!(
+        stats.dropped_tile_entries, 0,
+        "no tile's list overflowed: {stats:?}"
+    );
+    assert!(
+        stats.binned > 0 && stats.binned < counts.particles,
+        "{stats:?}: culled out of view"
+    );
     let by_id: HashMap<u32, &Particle> = cpu.iter().map(|p| (p.id, p)).collect();
     let matched: Vec<(&Particle, &Particle)> = gpu
         .iter()

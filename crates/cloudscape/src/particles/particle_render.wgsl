@@ -9,7 +9,7 @@
 struct Render {
     grid_size: vec2<u32>,          // output texels
     tiles: vec2<u32>,              // tiles across and down
-    tile_capacity: u32,            // entries a tile holds
+    tile_capacity: u32,            // entries a tile's list holds (MAX_TILE_ENTRIES are blended)
     blending: u32,                 // Blending::gpu_index: 0 volume-aware, 1 alpha
     max_particles: u32,            // capacity of the particle buffer
     flat_planet: u32,              // 1 on a flat planet
@@ -73,31 +73,49 @@ fn grid_texel(pixel: vec2<f32>) -> vec2<f32> {
     return (pixel - vec2<f32>(frame.grid_subpixel)) / f32(frame.grid_divisor);
 }
 
-// The output texels the particle may cover, (min.xy, max.xy); min > max when none.
+// Clip-space w below which a point counts as behind the eye (w is the view depth, m).
+const FOOTPRINT_MIN_W: f32 = 0.01;
+
+// Output texel coordinates of a clip-space point in front of the eye.
+fn footprint_texel(clip: vec4<f32>) -> vec2<f32> {
+    let ndc = clip.xy / clip.w;
+    return grid_texel(vec2<f32>(0.5 * (ndc.x + 1.0), 0.5 * (1.0 - ndc.y)) * frame.viewport_px);
+}
+
+// The output texels the particle may cover, (min.xy, max.xy); min > max when none: the screen
+// bounds of its bounding cube's part in front of the eye (the cube's corners there, and where its
+// edges cross the plane w = FOOTPRINT_MIN_W). A particle the eye is in covers the whole screen:
+// it is clipped, not dropped.
 fn particle_footprint(p: Particle) -> vec4<i32> {
-    let all = vec4<i32>(0, 0, vec2<i32>(render.grid_size) - 1);
+    let screen = vec4<i32>(0, 0, vec2<i32>(render.grid_size) - 1);
     let r = max(p.radius_m, p.height_m);
-    let to_centre = p.centre_m - frame.camera_position_m;
-    let forward = normalize((frame.world_from_view * vec4<f32>(0.0, 0.0, -1.0, 0.0)).xyz);
-    let along = dot(to_centre, forward);
-    if along < -r {
-        return vec4<i32>(1, 1, 0, 0);
+    if all(abs(frame.camera_position_m - p.centre_m) < vec3<f32>(r)) {
+        return screen;
     }
-    if along < 1.74 * r {
-        return all; // the bounding cube reaches the camera plane: clipped, not dropped
+    var corners: array<vec4<f32>, 8>;
+    for (var k = 0u; k < 8u; k++) {
+        let unit = vec3<f32>(f32(k & 1u), f32((k >> 1u) & 1u), f32((k >> 2u) & 1u));
+        corners[k] = frame.clip_from_world * vec4<f32>(p.centre_m + r * (2.0 * unit - 1.0), 1.0);
     }
     var lo = vec2<f32>(3.0e38);
     var hi = vec2<f32>(-3.0e38);
     for (var k = 0u; k < 8u; k++) {
-        let corner = p.centre_m + r * vec3<f32>(f32(k & 1u), f32((k >> 1u) & 1u), f32((k >> 2u) & 1u)) * 2.0 - r;
-        let clip = frame.clip_from_world * vec4<f32>(corner, 1.0);
-        let ndc = clip.xy / clip.w;
-        let pixel = vec2<f32>(0.5 * (ndc.x + 1.0), 0.5 * (1.0 - ndc.y)) * frame.viewport_px;
-        lo = min(lo, grid_texel(pixel));
-        hi = max(hi, grid_texel(pixel));
+        let a = corners[k];
+        if a.w >= FOOTPRINT_MIN_W {
+            lo = min(lo, footprint_texel(a));
+            hi = max(hi, footprint_texel(a));
+        }
+        for (var axis = 0u; axis < 3u; axis++) {
+            let b = corners[k ^ (1u << axis)];
+            if (a.w < FOOTPRINT_MIN_W) != (b.w < FOOTPRINT_MIN_W) {
+                let crossing = mix(a, b, (FOOTPRINT_MIN_W - a.w) / (b.w - a.w));
+                lo = min(lo, footprint_texel(crossing));
+                hi = max(hi, footprint_texel(crossing));
+            }
+        }
     }
-    let first = max(vec2<i32>(floor(lo)) - 1, all.xy);
-    let last = min(vec2<i32>(ceil(hi)) + 1, all.zw);
+    let first = max(vec2<i32>(floor(clamp(lo, vec2<f32>(-1.0e6), vec2<f32>(1.0e6)))) - 1, screen.xy);
+    let last = min(vec2<i32>(ceil(clamp(hi, vec2<f32>(-1.0e6), vec2<f32>(1.0e6)))) + 1, screen.zw);
     return vec4<i32>(first, last);
 }
 
@@ -135,6 +153,52 @@ fn bin_particles(@builtin(global_invocation_id) id: vec3<u32>) {
 
 var<workgroup> tile_keys: array<u32, MAX_TILE_ENTRIES>;
 var<workgroup> tile_length: u32;
+// A long list's keys by the top 8 bits of their distance level, to keep the nearest.
+var<workgroup> tile_histogram: array<atomic<u32>, 256>;
+var<workgroup> tile_cut: vec2<u32>; // (first distance bin left out or partly kept, keys kept)
+var<workgroup> tile_fill: atomic<u32>;
+
+// Loads the tile's `listed` keys into workgroup memory: all of them when they fit, otherwise the
+// nearest MAX_TILE_ENTRIES (by a histogram of their distance, so the far ones a full tile drops
+// are the ones its nearer particles hide). Returns how many were loaded (uniform).
+fn load_tile_keys(first: u32, listed: u32, lane: u32) -> u32 {
+    if listed <= MAX_TILE_ENTRIES {
+        for (var i = lane; i < listed; i += TILE * TILE) {
+            tile_keys[i] = tile_entries[first + i];
+        }
+        return listed;
+    }
+    atomicStore(&tile_histogram[lane], 0u);
+    if lane == 0u {
+        atomicStore(&tile_fill, 0u);
+    }
+    workgroupBarrier();
+    for (var i = lane; i < listed; i += TILE * TILE) {
+        atomicAdd(&tile_histogram[tile_entries[first + i] >> 24u], 1u);
+    }
+    workgroupBarrier();
+    if lane == 0u {
+        var kept = 0u;
+        var bin = 0u;
+        while bin < 256u && kept + atomicLoad(&tile_histogram[bin]) <= MAX_TILE_ENTRIES {
+            kept += atomicLoad(&tile_histogram[bin]);
+            bin++;
+        }
+        tile_cut = vec2<u32>(bin, kept);
+    }
+    let cut = workgroupUniformLoad(&tile_cut);
+    for (var i = lane; i < listed; i += TILE * TILE) {
+        let key = tile_entries[first + i];
+        if (key >> 24u) <= cut.x {
+            let slot = atomicAdd(&tile_fill, 1u);
+            if slot < MAX_TILE_ENTRIES {
+                tile_keys[slot] = key;
+            }
+        }
+    }
+    workgroupBarrier();
+    return MAX_TILE_ENTRIES;
+}
 
 // Sorts the first `size` (a power of two) keys of the tile, ascending: a bitonic network over
 // workgroup memory, each invocation taking every 256th pair.
@@ -337,13 +401,14 @@ fn render_tiles(
     if lane == 0u {
         tile_length = min(atomicLoad(&tile_counts[tile_index]), render.tile_capacity);
     }
-    let n = workgroupUniformLoad(&tile_length);
+    let listed = workgroupUniformLoad(&tile_length);
+    let n = load_tile_keys(tile_index * render.tile_capacity, listed, lane);
     var size = 1u;
     while size < n {
         size <<= 1u;
     }
-    for (var i = lane; i < size; i += TILE * TILE) {
-        tile_keys[i] = select(0xffffffffu, tile_entries[tile_index * render.tile_capacity + i], i < n);
+    for (var i = n + lane; i < size; i += TILE * TILE) {
+        tile_keys[i] = 0xffffffffu;
     }
     workgroupBarrier();
     sort_tile_keys(size, lane);

@@ -30,8 +30,13 @@ use crate::technique::{Technique, TechniqueStats, TechniqueTargets};
 
 /// Output texels along each side of a screen tile (`TILE` in `particle_render.wgsl`).
 pub const TILE_TEXELS: u32 = 16;
-/// Particles a tile's list holds (`MAX_TILE_ENTRIES`): the sort runs in 8 KiB of workgroup memory.
-pub const TILE_CAPACITY: u32 = 2048;
+/// Particles a tile sorts and blends (`MAX_TILE_ENTRIES`): the sort runs in 8 KiB of workgroup
+/// memory. A tile that lists more keeps its nearest.
+pub const TILE_SORTED: u32 = 2048;
+/// Most particles a tile's list holds (fewer where the lists would pass [`TILE_LIST_BYTES`]).
+pub const TILE_CAPACITY: u32 = 16384;
+/// Bytes of all tile lists at most.
+pub const TILE_LIST_BYTES: u64 = 96 << 20;
 
 /// The timed passes of a frame, in order.
 pub const PASS_NAMES: &[&str] = &["particles: generate", "particles: bin", "particles: render"];
@@ -75,6 +80,7 @@ pub struct ParticleStats {
 /// The tile lists, sized for one output.
 struct TileLists {
     tiles: UVec2,
+    capacity: u32,
     counts: wgpu::Buffer,
     entries: wgpu::Buffer,
 }
@@ -83,14 +89,13 @@ impl TileLists {
     fn new(ctx: &GpuContext, size: UVec2) -> TileLists {
         let tiles = tile_grid(size);
         let n = u64::from(tiles.x * tiles.y);
+        let capacity =
+            (TILE_LIST_BYTES / (4 * n)).clamp(u64::from(TILE_SORTED), u64::from(TILE_CAPACITY));
         TileLists {
             tiles,
+            capacity: capacity as u32,
             counts: storage_buffer(ctx, "particle tile counts", n * 4),
-            entries: storage_buffer(
-                ctx,
-                "particle tile entries",
-                n * u64::from(TILE_CAPACITY) * 4,
-            ),
+            entries: storage_buffer(ctx, "particle tile entries", n * capacity * 4),
         }
     }
 }
@@ -213,7 +218,6 @@ impl ParticleRenderer {
         let spec = &tables.spec;
         let od = spec.optical_depth;
         RenderUniform {
-            tile_capacity: TILE_CAPACITY,
             blending: Blending::from_scene(scene.particles.blending).gpu_index(),
             max_particles: MAX_PARTICLES,
             flat_planet: u32::from(scene.planet.shape == PlanetShape::Flat),
@@ -329,6 +333,7 @@ impl Technique for ParticleRenderer {
         let rows = (origin.y + size.y).div_ceil(TILE_TEXELS) - first_row;
         self.settings.grid_size = output.size;
         self.settings.tiles = lists.tiles;
+        self.settings.tile_capacity = lists.capacity;
         self.settings.band_first_tile_row = first_row;
         self.settings.band_rows = UVec2::new(origin.y, origin.y + size.y);
         ctx.queue
