@@ -196,6 +196,10 @@ fn light_occlusion_darkens_low_particles_and_its_early_exit_only_skips_opaque_pa
     without.particles.occlusion_early_exit = false;
     harness.render(&ctx, &without, &frame);
     let (without_exit, counts_without) = harness.generated(&ctx);
+    eprintln!(
+        "occlusion segments marched: {} with the early exit, {} without",
+        counts_with.occlusion_steps, counts_without.occlusion_steps
+    );
     assert!(
         counts_with.occlusion_steps < counts_without.occlusion_steps,
         "{counts_with:?} vs {counts_without:?}"

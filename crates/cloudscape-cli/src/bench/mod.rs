@@ -36,6 +36,11 @@ pub struct BenchArgs {
     /// give their frame times relative to the first [default: the scene's].
     #[arg(long, value_delimiter = ',', value_name = "NAMES")]
     techniques: Vec<String>,
+    /// One more run of the first technique with these overrides (comma-separated `KEY=VALUE`),
+    /// timed beside the others, e.g. `--variant particles.occlusion_early_exit=false`
+    /// (repeatable).
+    #[arg(long, value_name = "KEY=VALUE,...")]
+    variant: Vec<String>,
     #[command(flatten)]
     flythrough: flythrough::FlythroughArgs,
     #[command(flatten)]
@@ -95,12 +100,17 @@ pub fn run(args: BenchArgs) -> Result<()> {
 /// Times every technique asked for (the scene's by default) one after the other in this run, and
 /// prints each one's report and their frame times relative to the first.
 fn run_repeated(args: BenchArgs) -> Result<()> {
-    let overrides: Vec<Vec<String>> = if args.techniques.is_empty() {
+    let mut overrides: Vec<Vec<String>> = if args.techniques.is_empty() {
         vec![Vec::new()]
     } else {
         let set = |t: &String| vec![format!("render.technique={t}")];
         args.techniques.iter().map(set).collect()
     };
+    for variant in &args.variant {
+        let mut extra = overrides[0].clone();
+        extra.extend(variant.split(',').map(str::to_string));
+        overrides.push(extra);
+    }
     let first = args.scene.load(&overrides[0])?;
     let ctx = args.gpu.open(&first)?;
     let reports = overrides
@@ -121,7 +131,7 @@ fn run_repeated(args: BenchArgs) -> Result<()> {
             reports[0].technique
         );
         for r in &reports {
-            println!("  {:<12} {:.3}", r.technique, r.frame_wall.median_ms / base);
+            println!("  {:<40} {:.3}", r.technique, r.frame_wall.median_ms / base);
         }
     }
     Ok(())
@@ -155,8 +165,13 @@ fn time_frames(args: &BenchArgs, ctx: &GpuContext, extra: &[String]) -> Result<R
         }
     }
     let stats = renderer.stats(ctx);
+    let variant = extra.iter().filter(|o| !o.starts_with("render.technique="));
+    let label = std::iter::once(scene.render.technique.name().to_string())
+        .chain(variant.cloned())
+        .collect::<Vec<_>>()
+        .join(" ");
     Ok(Report {
-        technique: scene.render.technique.name().to_string(),
+        technique: label,
         adapter: ctx.summary(),
         width: frame.size.x,
         height: frame.size.y,

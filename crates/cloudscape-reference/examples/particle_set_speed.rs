@@ -1,0 +1,102 @@
+//! Timing harness: samples per second of the path tracer on the default scene's cloud field and on
+//! the particle technique's own particle set of it (as `cloudscape report` traces them), at
+//! 160x90 with a few samples per pixel.
+//!
+//! `cargo run --release -p cloudscape-reference --example particle_set_speed [spp] [seconds] [both|field|particles]`
+
+use cloudscape::environment::Environment;
+use cloudscape::field::CloudField;
+use cloudscape::particles::ParticleTableSpec;
+use cloudscape::particles::density::RadialProfile;
+use cloudscape::particles::generate::{self, Generation};
+use cloudscape::particles::grid::RingGrid;
+use cloudscape::scene::Scene;
+use cloudscape_reference::medium::Medium;
+use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer, ProgressiveRender};
+use glam::{UVec2, Vec3};
+use std::path::Path;
+use std::time::Instant;
+
+/// Samples per second over up to `spp` samples per pixel, stopping (between rows) after
+/// `budget_s` seconds, and the image's mean radiance.
+fn speed<M: Medium>(tracer: &PathTracer<M>, spp: u32, budget_s: f64) -> (f64, f64) {
+    let mut render = ProgressiveRender::new(tracer, 1);
+    let deadline = Instant::now() + std::time::Duration::from_secs_f64(budget_s);
+    let stop = || Instant::now() >= deadline;
+    render.run_pass(spp, &stop, &|_| {});
+    let stats = render.stats();
+    let image = render.image();
+    let mean = image
+        .pixels
+        .iter()
+        .map(|p| f64::from(p[0] + p[1] + p[2]) / 3.0)
+        .sum::<f64>()
+        / image.pixels.len() as f64;
+    (stats.samples_per_second(), mean)
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let spp: u32 = args.next().and_then(|s| s.parse().ok()).unwrap_or(4);
+    let budget_s: f64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(20.0);
+    let which = args.next().unwrap_or_else(|| "both".into());
+    let scene = Scene::default();
+    let size = UVec2::new(160, 90);
+
+    let mut field_speed = f64::NAN;
+    if which != "particles" {
+        let start = Instant::now();
+        let field_tracer =
+            PathTracer::for_scene(&scene, Path::new(""), size, DEFAULT_MAJORANT_CELLS)
+                .expect("the default scene");
+        eprintln!("field tracer built in {:?}", start.elapsed());
+        let (speed, mean) = speed(&field_tracer, spp, budget_s);
+        eprintln!("field: {speed:.0} samples/s (mean radiance {mean:.4})");
+        field_speed = speed;
+    }
+    if which == "field" {
+        return;
+    }
+    let field = CloudField::new(&scene, Path::new("")).expect("the default scene");
+    field.bake_noise();
+    let spec = ParticleTableSpec::from_scene(&scene);
+    let generation = Generation {
+        grid: RingGrid::from_scene(&scene),
+        camera_m: Vec3::from_array(scene.camera.position_m),
+        sun_direction: Environment::from_scene(&scene).sun.direction,
+        time_s: scene.render.time_s,
+        sigma_max_per_m: spec.extinction_per_m,
+        particle_mean_density: RadialProfile::of(&spec.particle).volume_mean(),
+        occlusion_early_exit: scene.particles.occlusion_early_exit,
+    };
+    let start = Instant::now();
+    let particles = generate::generate(&field, &generation);
+    eprintln!(
+        "{} particles generated in {:?}",
+        particles.len(),
+        start.elapsed()
+    );
+    let start = Instant::now();
+    let tracer = PathTracer::for_particle_set(
+        &scene,
+        size,
+        &particles,
+        spec.particle,
+        spec.extinction_per_m,
+        DEFAULT_MAJORANT_CELLS,
+    );
+    eprintln!(
+        "particle tracer built in {:?}: {} particles in the medium, grid {} over {:?}, mean majorant {:.5} m^-1",
+        start.elapsed(),
+        tracer.volume.medium.len(),
+        tracer.volume.grid.dims(),
+        tracer.volume.grid.bounds(),
+        tracer.volume.grid.mean_majorant_per_m()
+    );
+    let (particle_speed, particle_mean) = speed(&tracer, spp, budget_s);
+    eprintln!("particles: {particle_speed:.0} samples/s (mean radiance {particle_mean:.4})");
+    println!(
+        "field {field_speed:.0} samples/s, particles {particle_speed:.0} samples/s, ratio {:.1}",
+        field_speed / particle_speed
+    );
+}
