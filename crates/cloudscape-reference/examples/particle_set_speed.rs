@@ -13,26 +13,67 @@ use cloudscape::particles::grid::RingGrid;
 use cloudscape::scene::Scene;
 use cloudscape_reference::medium::Medium;
 use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer, ProgressiveRender};
+use cloudscape_reference::geometry::Aabb;
+use cloudscape_reference::medium::Support;
+use cloudscape_reference::tracking::TrackedMedium;
 use glam::{UVec2, Vec3};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::path::Path;
 use std::time::Instant;
 
-/// Samples per second over up to `spp` samples per pixel, stopping (between rows) after
-/// `budget_s` seconds, and the image's mean radiance.
-fn speed<M: Medium>(tracer: &PathTracer<M>, spp: u32, budget_s: f64) -> (f64, f64) {
-    let mut render = ProgressiveRender::new(tracer, 1);
+/// A medium that counts its extinction queries.
+struct Counted<M> {
+    medium: M,
+    queries: AtomicU64,
+}
+
+impl<M: Medium> Medium for Counted<M> {
+    fn extinction_per_m(&self, p: Vec3) -> f32 {
+        self.queries.fetch_add(1, Ordering::Relaxed);
+        self.medium.extinction_per_m(p)
+    }
+    fn max_extinction_in_box(&self, b: &Aabb) -> f32 {
+        self.medium.max_extinction_in_box(b)
+    }
+    fn support(&self) -> Support {
+        self.medium.support()
+    }
+}
+
+/// `tracer` with its extinction queries counted.
+fn counted<M: Medium>(tracer: PathTracer<M>) -> PathTracer<Counted<M>> {
+    PathTracer {
+        volume: TrackedMedium {
+            medium: Counted {
+                medium: tracer.volume.medium,
+                queries: AtomicU64::new(0),
+            },
+            grid: tracer.volume.grid,
+        },
+        phase: tracer.phase,
+        albedo: tracer.albedo,
+        environment: tracer.environment,
+        frame: tracer.frame,
+        max_scattering_orders: tracer.max_scattering_orders,
+    }
+}
+
+/// Extinction queries per sample, and seconds per query, of `spp` samples per pixel within
+/// `budget_s`.
+fn report<M: Medium>(name: &str, tracer: PathTracer<M>, spp: u32, budget_s: f64) -> f64 {
+    let tracer = counted(tracer);
+    let mut render = ProgressiveRender::new(&tracer, 1);
     let deadline = Instant::now() + std::time::Duration::from_secs_f64(budget_s);
     let stop = || Instant::now() >= deadline;
     render.run_pass(spp, &stop, &|_| {});
     let stats = render.stats();
-    let image = render.image();
-    let mean = image
-        .pixels
-        .iter()
-        .map(|p| f64::from(p[0] + p[1] + p[2]) / 3.0)
-        .sum::<f64>()
-        / image.pixels.len() as f64;
-    (stats.samples_per_second(), mean)
+    let queries = tracer.volume.medium.queries.load(Ordering::Relaxed) as f64;
+    eprintln!(
+        "{name}: {:.0} samples/s, {:.0} extinction queries per sample",
+        stats.samples_per_second(),
+        queries / stats.samples as f64
+    );
+    stats.samples_per_second()
 }
 
 fn main() {
@@ -50,9 +91,7 @@ fn main() {
             PathTracer::for_scene(&scene, Path::new(""), size, DEFAULT_MAJORANT_CELLS)
                 .expect("the default scene");
         eprintln!("field tracer built in {:?}", start.elapsed());
-        let (speed, mean) = speed(&field_tracer, spp, budget_s);
-        eprintln!("field: {speed:.0} samples/s (mean radiance {mean:.4})");
-        field_speed = speed;
+        field_speed = report("field", field_tracer, spp, budget_s);
     }
     if which == "field" {
         return;
@@ -70,7 +109,11 @@ fn main() {
         occlusion_early_exit: scene.particles.occlusion_early_exit,
     };
     let start = Instant::now();
-    let particles = generate::generate(&field, &generation);
+    let mut particles = generate::generate(&field, &generation);
+    if let Some(reach) = std::env::var("REACH").ok().and_then(|s| s.parse::<f32>().ok()) {
+        let c = generation.camera_m;
+        particles.retain(|p| (p.centre_m - c).length() < reach);
+    }
     eprintln!(
         "{} particles generated in {:?}",
         particles.len(),
@@ -93,8 +136,7 @@ fn main() {
         tracer.volume.grid.bounds(),
         tracer.volume.grid.mean_majorant_per_m()
     );
-    let (particle_speed, particle_mean) = speed(&tracer, spp, budget_s);
-    eprintln!("particles: {particle_speed:.0} samples/s (mean radiance {particle_mean:.4})");
+    let particle_speed = report("particles", tracer, spp, budget_s);
     println!(
         "field {field_speed:.0} samples/s, particles {particle_speed:.0} samples/s, ratio {:.1}",
         field_speed / particle_speed

@@ -19,8 +19,10 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
 /// A particle's radius relative to its cell (Yusov's sample: size = cell x 2.2 x lerp(0.5, 1,
-/// noise) x saturate(density / 0.02), taken as the diameter; peers.md).
-pub const RADIUS_PER_CELL: f32 = 1.1;
+/// noise) x saturate(density / 0.02), the size being the radius; peers.md): neighbours overlap
+/// several times over, so their sum is a smooth volume rather than a pile of balls (half of it,
+/// tried first, left the gaps between particles visible).
+pub const RADIUS_PER_CELL: f32 = 2.2;
 /// Field density (relative to the layers' peak) at which a particle reaches its full size;
 /// thinner cloud makes smaller particles.
 pub const FULL_SIZE_DENSITY: f32 = 0.1;

@@ -52,7 +52,7 @@ const COUNT_DROPPED: u32 = 3u;
 @group(3) @binding(4) var<storage, read_write> particles: array<Particle>;
 
 const CELL_JITTER: f32 = 0.25;
-const RADIUS_PER_CELL: f32 = 1.1;
+const RADIUS_PER_CELL: f32 = 2.2;
 const FULL_SIZE_DENSITY: f32 = 0.1;
 const MIN_DENSITY: f32 = 0.01;
 const OCCLUSION_STEPS: u32 = 6u;
