@@ -129,10 +129,10 @@ fn main() {
         DEFAULT_MAJORANT_CELLS,
     );
     eprintln!(
-        "particle tracer built in {:?}: {} particles in the medium, grid {} over {:?}, mean majorant {:.5} m^-1",
+        "particle tracer built in {:?}: {} particles in the medium, {} grid levels over {:?}, mean majorant {:.5} m^-1",
         start.elapsed(),
         tracer.volume.medium.len(),
-        tracer.volume.grid.dims(),
+        tracer.volume.grid.level_count(),
         tracer.volume.grid.bounds(),
         tracer.volume.grid.mean_majorant_per_m()
     );

@@ -28,64 +28,70 @@ const CELL_PAD_M: f32 = 0.1;
 /// Cells are at most this much flatter than wide: layers are thin and vary fast with altitude.
 const MIN_CELL_ASPECT: f32 = 0.25;
 
-/// Majorants over a box, plus the medium's shell outside it.
+/// Majorants over a box, plus the medium's shell outside it. Where the medium asks for it
+/// ([`Medium::nesting`]), the box holds nested boxes about a focus, each grid twice as wide as the
+/// one inside it with as many cells, so that cells are small near the camera (where the particle
+/// technique's particles are small) and coarse far away.
 #[derive(Clone, Debug)]
 pub struct MajorantGrid {
+    /// Innermost first; each level's box holds the boxes of the levels before it.
+    levels: Vec<Level>,
+    shell: Option<Shell>,
+}
+
+/// One grid of majorants over a box.
+#[derive(Clone, Debug)]
+struct Level {
     bounds: Aabb,
     dims: UVec3,
     cell_size: Vec3,
     values: Vec<f32>,
-    shell: Option<Shell>,
 }
 
 impl MajorantGrid {
     /// Bounds `medium` over about `max_cells` cells covering its support box; cells are as wide as
-    /// deep and between 1 and 4 times wider than tall, following the box's proportions.
+    /// deep and between 1 and 4 times wider than tall, following the box's proportions. With
+    /// [`Medium::nesting`], the cells are shared among the nested levels.
     pub fn build(medium: &impl Medium, max_cells: usize) -> MajorantGrid {
         let support = medium.support();
-        let bounds = support.grid_box;
-        let dims = grid_dims(bounds.max - bounds.min, max_cells.max(1));
-        let cell_size = (bounds.max - bounds.min) / dims.as_vec3();
-        let pad = cell_size * CELL_PAD_FRACTION + CELL_PAD_M;
-        let (nx, ny) = (dims.x as usize, dims.y as usize);
-        let values = (0..dims.element_product() as usize)
-            .into_par_iter()
-            .map(|i| {
-                let cell = UVec3::new(
-                    (i % nx) as u32,
-                    (i / nx % ny) as u32,
-                    (i / (nx * ny)) as u32,
-                );
-                let min = bounds.min + cell.as_vec3() * cell_size;
-                medium.max_extinction_in_box(&Aabb {
-                    min: min - pad,
-                    max: min + cell_size + pad,
-                })
-            })
-            .collect();
+        let boxes = level_boxes(medium, &support.grid_box);
+        let cells = (max_cells / boxes.len()).max(1);
+        let mut levels: Vec<Level> = Vec::with_capacity(boxes.len());
+        for (k, bounds) in boxes.iter().enumerate() {
+            // Cells wholly inside the next level in, by a cell's margin, are never read.
+            let inner = k.checked_sub(1).map(|i| levels[i].bounds);
+            levels.push(Level::build(medium, *bounds, cells, inner));
+        }
         MajorantGrid {
-            bounds,
-            dims,
-            cell_size,
-            values,
+            levels,
             shell: support.shell,
         }
     }
 
-    /// Cells along x, y, z.
+    fn outer(&self) -> &Level {
+        self.levels.last().expect("at least one level")
+    }
+
+    /// Cells along x, y, z of the outermost level.
     pub fn dims(&self) -> UVec3 {
-        self.dims
+        self.outer().dims
     }
 
     /// The box the grid covers.
     pub fn bounds(&self) -> Aabb {
-        self.bounds
+        self.outer().bounds
     }
 
-    /// The majorant that applies at `p`: its cell's inside the box, the shell's in the band outside.
+    /// Nested levels (1 without [`Medium::nesting`]).
+    pub fn level_count(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// The majorant that applies at `p`: its cell's inside the box (in the innermost level holding
+    /// it), the shell's in the band outside.
     pub fn majorant_at(&self, p: Vec3) -> f32 {
-        if p.cmpge(self.bounds.min).all() && p.cmple(self.bounds.max).all() {
-            return self.values[self.index(self.cell_of(p))];
+        if let Some(level) = self.levels.iter().find(|l| l.contains(p)) {
+            return level.values[level.index(level.cell_of(p))];
         }
         self.shell.map_or(0.0, |s| {
             let h = s.planet.altitude_m(p);
@@ -97,21 +103,12 @@ impl MajorantGrid {
         })
     }
 
-    /// Mean majorant over the cells (a measure of how tight the grid is), m^-1.
+    /// Mean majorant over the cells of every level (a measure of how tight the grid is), m^-1.
     pub fn mean_majorant_per_m(&self) -> f32 {
-        self.values.iter().sum::<f32>() / self.values.len() as f32
-    }
-
-    fn cell_of(&self, p: Vec3) -> IVec3 {
-        ((p - self.bounds.min) / self.cell_size)
-            .floor()
-            .as_ivec3()
-            .clamp(IVec3::ZERO, self.dims.as_ivec3() - 1)
-    }
-
-    fn index(&self, cell: IVec3) -> usize {
-        let d = self.dims.as_ivec3();
-        (cell.x + d.x * (cell.y + d.y * cell.z)) as usize
+        let (sum, count) = self.levels.iter().fold((0.0, 0), |(s, n), l| {
+            (s + l.values.iter().sum::<f32>(), n + l.values.len())
+        });
+        sum / count as f32
     }
 
     /// Visits the stretches of the ray `origin + t dir`, `t` in `[0, t_max]`, that may hold
@@ -124,15 +121,43 @@ impl MajorantGrid {
         mut visit: impl FnMut(Segment) -> ControlFlow<R>,
     ) -> ControlFlow<R> {
         match self
-            .bounds
+            .bounds()
             .ray_interval(origin, dir)
             .and_then(|i| i.clip(0.0, t_max))
         {
             None => self.walk_shell(origin, dir, (0.0, t_max), &mut visit),
             Some(inside) => {
                 self.walk_shell(origin, dir, (0.0, inside.start), &mut visit)?;
-                self.walk_cells(origin, dir, (inside.start, inside.end), &mut visit)?;
+                let outer = self.levels.len() - 1;
+                self.walk_level(outer, origin, dir, (inside.start, inside.end), &mut visit)?;
                 self.walk_shell(origin, dir, (inside.end, t_max), &mut visit)
+            }
+        }
+    }
+
+    /// Walks the stretch `(start, end)` of the ray, inside level `k`'s box: through its cells
+    /// where the ray is outside the next level in, through that level where it is inside.
+    fn walk_level<R>(
+        &self,
+        k: usize,
+        origin: Vec3,
+        dir: Vec3,
+        (start, end): (f32, f32),
+        visit: &mut impl FnMut(Segment) -> ControlFlow<R>,
+    ) -> ControlFlow<R> {
+        let level = &self.levels[k];
+        let inner = k.checked_sub(1).and_then(|i| {
+            self.levels[i]
+                .bounds
+                .ray_interval(origin, dir)
+                .and_then(|r| r.clip(start, end))
+        });
+        match inner {
+            None => level.walk_cells(origin, dir, (start, end), visit),
+            Some(inner) => {
+                level.walk_cells(origin, dir, (start, inner.start), visit)?;
+                self.walk_level(k - 1, origin, dir, (inner.start, inner.end), visit)?;
+                level.walk_cells(origin, dir, (inner.end, end), visit)
             }
         }
     }
@@ -160,6 +185,113 @@ impl MajorantGrid {
         }
         ControlFlow::Continue(())
     }
+}
+
+/// The boxes of the levels, innermost first, the last `grid_box`: about the medium's focus, boxes
+/// of horizontal half-width `inner_reach_m * 2^k` until one holds `grid_box`, each clipped to
+/// `grid_box`, shrunk to the medium inside it ([`Medium::bounds_within`]) and to the next one out.
+/// Levels with no medium are left out (the next one out covers them).
+fn level_boxes(medium: &impl Medium, grid_box: &Aabb) -> Vec<Aabb> {
+    let Some(nesting) = medium.nesting() else {
+        return vec![*grid_box];
+    };
+    let mut reaches = Vec::new();
+    let mut reach = nesting.inner_reach_m.max(1.0);
+    let far = (grid_box.min - nesting.focus_m)
+        .abs()
+        .max((grid_box.max - nesting.focus_m).abs());
+    while reach < far.x.max(far.z) && reaches.len() < MAX_LEVELS - 1 {
+        reaches.push(reach);
+        reach *= 2.0;
+    }
+    let mut boxes = vec![*grid_box];
+    for &reach in reaches.iter().rev() {
+        let outer = *boxes.last().expect("the outermost box");
+        let half = Vec3::new(reach, 0.0, reach);
+        let square = Aabb {
+            min: (nesting.focus_m - half).max(outer.min),
+            max: (nesting.focus_m + half).min(outer.max),
+        };
+        let square = Aabb {
+            min: Vec3::new(square.min.x, outer.min.y, square.min.z),
+            max: Vec3::new(square.max.x, outer.max.y, square.max.z),
+        };
+        if square.min.cmpge(square.max).any() {
+            break;
+        }
+        let Some(tight) = medium.bounds_within(&square) else {
+            break;
+        };
+        let tight = Aabb {
+            min: tight.min.max(square.min),
+            max: tight.max.min(square.max),
+        };
+        if tight.min.cmpge(tight.max).any() {
+            break;
+        }
+        boxes.push(tight);
+    }
+    boxes.reverse();
+    boxes
+}
+
+/// Nested levels at most.
+const MAX_LEVELS: usize = 12;
+
+impl Level {
+    /// Bounds `medium` over about `max_cells` cells covering `bounds`; cells well inside `inner`
+    /// (which the grid reads instead) are set to 0 without a bound.
+    fn build(medium: &impl Medium, bounds: Aabb, max_cells: usize, inner: Option<Aabb>) -> Level {
+        let dims = grid_dims(bounds.max - bounds.min, max_cells.max(1));
+        let cell_size = (bounds.max - bounds.min) / dims.as_vec3();
+        let pad = cell_size * CELL_PAD_FRACTION + CELL_PAD_M;
+        let skipped = inner.map(|b| Aabb {
+            min: b.min + cell_size,
+            max: b.max - cell_size,
+        });
+        let (nx, ny) = (dims.x as usize, dims.y as usize);
+        let values = (0..dims.element_product() as usize)
+            .into_par_iter()
+            .map(|i| {
+                let cell = UVec3::new(
+                    (i % nx) as u32,
+                    (i / nx % ny) as u32,
+                    (i / (nx * ny)) as u32,
+                );
+                let min = bounds.min + cell.as_vec3() * cell_size;
+                let b = Aabb {
+                    min: min - pad,
+                    max: min + cell_size + pad,
+                };
+                if skipped.is_some_and(|s| b.min.cmpge(s.min).all() && b.max.cmple(s.max).all()) {
+                    return 0.0;
+                }
+                medium.max_extinction_in_box(&b)
+            })
+            .collect();
+        Level {
+            bounds,
+            dims,
+            cell_size,
+            values,
+        }
+    }
+
+    fn contains(&self, p: Vec3) -> bool {
+        p.cmpge(self.bounds.min).all() && p.cmple(self.bounds.max).all()
+    }
+
+    fn cell_of(&self, p: Vec3) -> IVec3 {
+        ((p - self.bounds.min) / self.cell_size)
+            .floor()
+            .as_ivec3()
+            .clamp(IVec3::ZERO, self.dims.as_ivec3() - 1)
+    }
+
+    fn index(&self, cell: IVec3) -> usize {
+        let d = self.dims.as_ivec3();
+        (cell.x + d.x * (cell.y + d.y * cell.z)) as usize
+    }
 
     /// 3D digital differential analyser through the cells (Amanatides & Woo 1987, "A Fast Voxel
     /// Traversal Algorithm for Ray Tracing"); zero cells are skipped without a visit.
@@ -170,6 +302,9 @@ impl MajorantGrid {
         (start, end): (f32, f32),
         visit: &mut impl FnMut(Segment) -> ControlFlow<R>,
     ) -> ControlFlow<R> {
+        if end <= start {
+            return ControlFlow::Continue(());
+        }
         let mut cell = self.cell_of(origin + dir * start);
         let step = IVec3::new(
             dir.x.signum() as i32,

@@ -24,6 +24,28 @@ pub trait Medium: Sync {
 
     /// Where the extinction may be non-zero.
     fn support(&self) -> Support;
+
+    /// Whether the majorant grid should nest finer levels about a focus (see
+    /// [`crate::majorant::MajorantGrid`]); None (the default) for one uniform grid.
+    fn nesting(&self) -> Option<Nesting> {
+        None
+    }
+
+    /// A box holding every point of `region` where the extinction may be non-zero, or None where
+    /// there is none; `region` itself by default. Nested majorant levels are shrunk to it.
+    fn bounds_within(&self, region: &Aabb) -> Option<Aabb> {
+        Some(*region)
+    }
+}
+
+/// Nested majorant levels about a point: the innermost reaches `inner_reach_m` horizontally from
+/// `focus_m`, each next one twice as far, until one holds the support box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Nesting {
+    /// Centre of the levels (the camera), m.
+    pub focus_m: Vec3,
+    /// Horizontal half-width of the innermost level, m.
+    pub inner_reach_m: f32,
 }
 
 /// The region outside which a medium's extinction is zero: a box, which the majorant grid covers

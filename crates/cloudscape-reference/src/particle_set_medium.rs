@@ -9,7 +9,11 @@
 //! `particle_render.wgsl` does: `local = (p - centre) / (radius, height, radius)`, and reads the
 //! reference particle turned by its random orientation `q = particle_rotation(id)`, as the GPU's
 //! `particle_rotate(q, local)` (glam's `q * local`). Its extinction there is
-//! `sigma_max * density * reference.density(q * local)`.
+//! `sigma_max * density * volume.density(q * local)`, where `volume` is the reference particle's
+//! noise baked into a [`NoiseVolume`] of [`NOISE_VOLUME_SIZE`]^3 voxels: the very noise the GPU
+//! integrates its particle tables through (`particle_bake.wgsl`), with the falloff and the edges
+//! evaluated exactly. It is within the volume's trilinear error of `reference.density` (about
+//! 0.01 in the mean) and costs one trilinear read per particle instead of four Perlin octaves.
 //!
 //! Point queries and box bounds walk a bounding volume hierarchy over the particles' boxes
 //! (median splits along the widest axis of the centres), so that hundreds of thousands of
@@ -17,8 +21,10 @@
 
 use crate::geometry::Aabb;
 use crate::medium::{Medium, Support};
-use cloudscape::particles::density::{ReferenceParticle, metaball_falloff};
+use crate::medium::Nesting;
+use cloudscape::particles::density::{NoiseVolume, ReferenceParticle, metaball_falloff};
 use cloudscape::particles::generate::Particle;
+use cloudscape::particles::gpu::NOISE_VOLUME_SIZE;
 use cloudscape::particles::optical_depth::particle_rotation;
 use cloudscape::scene::ParticleStyle;
 use glam::{Quat, Vec3};
@@ -97,6 +103,9 @@ struct Node {
 #[derive(Clone, Debug)]
 pub struct ParticleSetMedium {
     reference: ReferenceParticle,
+    /// The reference particle's noise, baked.
+    noise: NoiseVolume,
+    nesting: Option<Nesting>,
     /// In leaf order.
     particles: Vec<Placed>,
     nodes: Vec<Node>,
@@ -141,6 +150,8 @@ impl ParticleSetMedium {
         );
         ParticleSetMedium {
             reference,
+            noise: NoiseVolume::bake(&reference, NOISE_VOLUME_SIZE),
+            nesting: None,
             particles: placed,
             nodes,
             support: Support {
@@ -148,6 +159,25 @@ impl ParticleSetMedium {
                 shell: None,
             },
         }
+    }
+
+    /// The medium with its majorant grid nested about `focus_m` (the camera), the innermost level
+    /// reaching `inner_reach_m` horizontally (see [`crate::majorant::MajorantGrid`]): the particle
+    /// technique's particles grow with the distance from the camera, and so should the cells
+    /// that bound them.
+    pub fn nested_about(self, focus_m: Vec3, inner_reach_m: f32) -> ParticleSetMedium {
+        ParticleSetMedium {
+            nesting: Some(Nesting {
+                focus_m,
+                inner_reach_m,
+            }),
+            ..self
+        }
+    }
+
+    /// The baked noise the extinction reads (see the module's documentation).
+    pub fn noise(&self) -> &NoiseVolume {
+        &self.noise
     }
 
     /// Particles in the medium (those with volume and positive density).
@@ -258,7 +288,7 @@ impl Medium for ParticleSetMedium {
             |q| {
                 let local = (p - q.centre_m) * q.inv_radii;
                 if local.length_squared() < 1.0 {
-                    sum += q.extinction_per_m * self.reference.density(q.rotation * local);
+                    sum += q.extinction_per_m * self.noise.density(q.rotation * local);
                 }
             },
         );
@@ -281,5 +311,23 @@ impl Medium for ParticleSetMedium {
 
     fn support(&self) -> Support {
         self.support
+    }
+
+    fn nesting(&self) -> Option<Nesting> {
+        self.nesting
+    }
+
+    fn bounds_within(&self, region: &Aabb) -> Option<Aabb> {
+        let mut bounds: Option<Aabb> = None;
+        self.visit(
+            |node| node.overlaps(region),
+            |q| {
+                let b = q.aabb();
+                if b.overlaps(region) {
+                    bounds = Some(bounds.map_or(b, |a| a.union(&b)));
+                }
+            },
+        );
+        bounds
     }
 }

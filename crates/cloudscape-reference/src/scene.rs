@@ -15,7 +15,7 @@ use cloudscape::optics::PhaseLobes;
 use cloudscape::particles::density::ReferenceParticle;
 use cloudscape::particles::generate::Particle;
 use cloudscape::scene::Scene;
-use glam::UVec2;
+use glam::{UVec2, Vec3};
 use std::path::Path;
 
 /// Majorant cells for a full render: 4 M cells (16 MiB), built in about a second on two cores in
@@ -25,6 +25,12 @@ pub const DEFAULT_MAJORANT_CELLS: usize = 1 << 22;
 /// Farthest horizontal distance from the camera that the majorant grid covers, metres; beyond,
 /// the layers' single band bound applies.
 const MAX_GRID_REACH_M: f32 = 150_000.0;
+
+/// Horizontal half-width of the innermost level of a particle set's nested majorant grid, metres:
+/// each level out is twice as wide with as many cells, as each ring of the particle technique's
+/// grid has cells twice the size of the one inside it. Camera rays meet the cloud mostly within a
+/// few kilometres, where the innermost levels' cells are a few tens of metres wide.
+const PARTICLE_GRID_INNER_REACH_M: f32 = 2_000.0;
 
 impl PathTracer<CloudMedium> {
     /// The path tracer of `scene` at `size` pixels; files resolve against `base_dir`. Bakes the
@@ -61,7 +67,13 @@ impl PathTracer<ParticleSetMedium> {
     /// ellipsoid of `reference` of peak extinction `sigma_max_per_m * density` (Yusov 2014; see
     /// [`ParticleSetMedium`]). The scene's reference particle and extinction are those of
     /// `cloudscape::particles::ParticleTableSpec::from_scene`. Builds a majorant grid of about
-    /// `majorant_cells` cells over the particles' bounds (see [`DEFAULT_MAJORANT_CELLS`]).
+    /// `majorant_cells` cells over the particles' bounds (see [`DEFAULT_MAJORANT_CELLS`]), in
+    /// levels nested about the camera (see [`ParticleSetMedium::nested_about`]).
+    ///
+    /// Particles wholly farther than the camera's far distance (`camera.far_m`) from the camera
+    /// are left out: camera rays see no medium beyond it (here as in [`PathTracer::for_scene`] and
+    /// on the GPU), so they would only shadow or light the medium within it along paths that
+    /// leave it sideways, which no technique renders either.
     pub fn for_particle_set(
         scene: &Scene,
         size: UVec2,
@@ -74,8 +86,19 @@ impl PathTracer<ParticleSetMedium> {
             shape: scene.planet.shape,
             radius_m: scene.planet.radius_m,
         };
-        PathTracer::in_scene(scene, size, planet, majorant_cells, |_| {
-            ParticleSetMedium::new(particles, reference, sigma_max_per_m)
+        PathTracer::in_scene(scene, size, planet, majorant_cells, |frame| {
+            let camera = frame.camera_position_m;
+            let seen: Vec<Particle> = particles
+                .iter()
+                .filter(|p| {
+                    let radii = Vec3::new(p.radius_m, p.height_m, p.radius_m);
+                    let nearest = camera.clamp(p.centre_m - radii, p.centre_m + radii);
+                    nearest.distance(camera) <= frame.far_m
+                })
+                .copied()
+                .collect();
+            ParticleSetMedium::new(&seen, reference, sigma_max_per_m)
+                .nested_about(camera, PARTICLE_GRID_INNER_REACH_M)
         })
     }
 }
