@@ -23,3 +23,22 @@ for i, frame in enumerate(frames):
 strip.save(sys.argv[2])
 PY
 rm -rf "$frames"
+# The ray marcher beside the particle technique: the default scene and the layer from above.
+pair=$(mktemp -d)
+for technique in raymarch particles; do
+    "$cloudscape" render --technique "$technique" --width 640 --height 360 --out "$pair/ground-$technique.png"
+    "$cloudscape" render scenes/above-the-layer.toml --technique "$technique" --width 640 --height 360 \
+        --out "$pair/above-$technique.png"
+done
+python3 - "$pair" "$out/raymarch-vs-particles.png" <<'PY'
+import sys
+from PIL import Image
+names = ["ground-raymarch", "ground-particles", "above-raymarch", "above-particles"]
+images = [Image.open(f"{sys.argv[1]}/{n}.png").convert("RGB") for n in names]
+w, h = images[0].size
+grid = Image.new("RGB", (2 * w, 2 * h))
+for i, image in enumerate(images):
+    grid.paste(image, ((i % 2) * w, (i // 2) * h))
+grid.save(sys.argv[2])
+PY
+rm -rf "$pair"
