@@ -3,6 +3,7 @@
 //! 160x90 with a few samples per pixel.
 //!
 //! `cargo run --release -p cloudscape-reference --example particle_set_speed [spp] [seconds] [both|field|particles]`
+//! (`REACH=metres` keeps only the particles whose centres are that close to the camera).
 
 use cloudscape::environment::Environment;
 use cloudscape::field::CloudField;
@@ -11,14 +12,14 @@ use cloudscape::particles::density::RadialProfile;
 use cloudscape::particles::generate::{self, Generation};
 use cloudscape::particles::grid::RingGrid;
 use cloudscape::scene::Scene;
-use cloudscape_reference::medium::Medium;
-use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer, ProgressiveRender};
 use cloudscape_reference::geometry::Aabb;
+use cloudscape_reference::medium::Medium;
 use cloudscape_reference::medium::Support;
 use cloudscape_reference::tracking::TrackedMedium;
+use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer, ProgressiveRender};
 use glam::{UVec2, Vec3};
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 /// A medium that counts its extinction queries.
@@ -110,7 +111,10 @@ fn main() {
     };
     let start = Instant::now();
     let mut particles = generate::generate(&field, &generation);
-    if let Some(reach) = std::env::var("REACH").ok().and_then(|s| s.parse::<f32>().ok()) {
+    if let Some(reach) = std::env::var("REACH")
+        .ok()
+        .and_then(|s| s.parse::<f32>().ok())
+    {
         let c = generation.camera_m;
         particles.retain(|p| (p.centre_m - c).length() < reach);
     }

@@ -20,14 +20,14 @@
 //! particles cost a few dozen box tests per query.
 
 use crate::geometry::Aabb;
-use crate::medium::{Medium, Support};
 use crate::medium::Nesting;
+use crate::medium::{Medium, Support};
 use cloudscape::particles::density::{NoiseVolume, ReferenceParticle, metaball_falloff};
 use cloudscape::particles::generate::Particle;
 use cloudscape::particles::gpu::NOISE_VOLUME_SIZE;
 use cloudscape::particles::optical_depth::particle_rotation;
 use cloudscape::scene::ParticleStyle;
-use glam::{Quat, Vec3};
+use glam::{IVec3, Quat, Vec3};
 
 /// The reference particle's largest density: every style ends in a clamp to [0, 1] or a
 /// smoothstep (`ReferenceParticle::density_with_noise`), so its density is at most 1.
@@ -180,6 +180,35 @@ impl ParticleSetMedium {
         &self.noise
     }
 
+    /// [`NoiseVolume::sample`] at `p` (particle space, inside the unit ball), the same sum in the
+    /// same order without its generic fetches and `floor` calls.
+    fn noise_at(&self, p: Vec3) -> f32 {
+        let n = self.noise.size as i32;
+        let x = (p + 1.0) * 0.5 * n as f32 - 0.5;
+        // Truncation is the floor here: x > -1 inside the unit cube.
+        let t = x.as_ivec3();
+        let base = t - IVec3::from(x.cmplt(t.as_vec3()));
+        let f = x - base.as_vec3();
+        let clamp = |i: i32| i.clamp(0, n - 1) as usize;
+        let (xs, ys, zs) = (
+            [clamp(base.x), clamp(base.x + 1)],
+            [clamp(base.y), clamp(base.y + 1)],
+            [clamp(base.z), clamp(base.z + 1)],
+        );
+        let (wxs, wys, wzs) = ([1.0 - f.x, f.x], [1.0 - f.y, f.y], [1.0 - f.z, f.z]);
+        let n = n as usize;
+        let mut out = 0.0;
+        for (z, wz) in zs.into_iter().zip(wzs) {
+            for (y, wy) in ys.into_iter().zip(wys) {
+                let row = n * (y + n * z);
+                for (x, wx) in xs.into_iter().zip(wxs) {
+                    out += self.noise.values[row + x] * (wx * wy * wz);
+                }
+            }
+        }
+        out
+    }
+
     /// Particles in the medium (those with volume and positive density).
     pub fn len(&self) -> usize {
         self.particles.len()
@@ -288,7 +317,9 @@ impl Medium for ParticleSetMedium {
             |q| {
                 let local = (p - q.centre_m) * q.inv_radii;
                 if local.length_squared() < 1.0 {
-                    sum += q.extinction_per_m * self.noise.density(q.rotation * local);
+                    let local = q.rotation * local;
+                    let noise = self.noise_at(local);
+                    sum += q.extinction_per_m * self.reference.density_with_noise(local, noise);
                 }
             },
         );

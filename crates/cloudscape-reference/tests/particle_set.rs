@@ -2,8 +2,9 @@
 //! extinction is the brute-force sum over the particles, its majorants bound it, and a render of
 //! a few particles under the default scene's sun shows them.
 
-use cloudscape::particles::density::ReferenceParticle;
+use cloudscape::particles::density::{NoiseVolume, ReferenceParticle};
 use cloudscape::particles::generate::Particle;
+use cloudscape::particles::gpu::NOISE_VOLUME_SIZE;
 use cloudscape::particles::optical_depth::particle_rotation;
 use cloudscape::scene::{ParticleStyle, Scene};
 use cloudscape_reference::geometry::Aabb;
@@ -89,15 +90,24 @@ fn query_points(particles: &[Particle], count: u64, seed: u64) -> Vec<Vec3> {
         .collect()
 }
 
-/// The definition, particle by particle: `sigma_max * density * reference(q * local)` with
+/// The definition, particle by particle: `sigma_max * density * density(q * local)` with
 /// `local = (p - centre) / (radius, height, radius)` and `q = particle_rotation(id)`, as
-/// `particle_segment` in `particle_render.wgsl` reads the reference particle.
-fn brute_force(particles: &[Particle], reference: &ReferenceParticle, p: Vec3) -> f32 {
+/// `particle_segment` in `particle_render.wgsl` reads the reference particle, `density` the
+/// reference particle's with its noise from `volume` (as the GPU bakes its tables) or, without
+/// it, evaluated exactly.
+fn brute_force(
+    particles: &[Particle],
+    reference: &ReferenceParticle,
+    volume: Option<&NoiseVolume>,
+    p: Vec3,
+) -> f32 {
     particles
         .iter()
         .map(|k| {
             let local = (p - k.centre_m) / Vec3::new(k.radius_m, k.height_m, k.radius_m);
-            SIGMA_MAX_PER_M * k.density * reference.density(particle_rotation(k.id) * local)
+            let q = particle_rotation(k.id) * local;
+            let density = volume.map_or_else(|| reference.density(q), |v| v.density(q));
+            SIGMA_MAX_PER_M * k.density * density
         })
         .sum()
 }
@@ -109,20 +119,31 @@ fn extinction_is_the_sum_over_the_particles() {
         let reference = reference(style);
         let medium = ParticleSetMedium::new(&particles, reference, SIGMA_MAX_PER_M);
         assert_eq!(medium.len(), 270, "the zero-density particles are left out");
-        let mut inside = 0;
+        let volume = NoiseVolume::bake(&reference, NOISE_VOLUME_SIZE);
+        assert_eq!(medium.noise(), &volume);
+        let (mut inside, mut error, mut total) = (0, 0.0f64, 0.0f64);
         for p in query_points(&particles, 4000, 2) {
-            let expected = brute_force(&particles, &reference, p);
+            let expected = brute_force(&particles, &reference, Some(&volume), p);
             let got = medium.extinction_per_m(p);
             assert!(
                 (got - expected).abs() <= 1e-5 * expected + 1e-7,
                 "{style:?} at {p}: {got} vs {expected}"
             );
             inside += usize::from(expected > 0.0);
+            // The baked noise is within its trilinear error of the exact one.
+            let exact = brute_force(&particles, &reference, None, p);
+            error += f64::from((got - exact).abs());
+            total += f64::from(exact);
         }
         assert!(
             inside > 1000,
             "{style:?}: only {inside} points in the medium"
         );
+        eprintln!(
+            "{style:?}: baked noise off the exact by {:.4}",
+            error / total
+        );
+        assert!(error < 0.005 * total, "{style:?}: {error} of {total}");
     }
     // Outside every particle, and without particles, there is nothing.
     let medium = ParticleSetMedium::new(&particles, reference(ParticleStyle::Smooth), 1.0);
@@ -136,9 +157,14 @@ fn extinction_is_the_sum_over_the_particles() {
 #[test]
 fn majorants_bound_the_extinction() {
     let particles = random_particles(400, 3);
-    for style in STYLES {
-        let medium = ParticleSetMedium::new(&particles, reference(style), SIGMA_MAX_PER_M);
+    for (style, nested) in STYLES.into_iter().flat_map(|s| [(s, false), (s, true)]) {
+        let mut medium = ParticleSetMedium::new(&particles, reference(style), SIGMA_MAX_PER_M);
+        if nested {
+            // Levels 200 m, 400 m, 800 m and the whole set (1.4 km) wide about a corner.
+            medium = medium.nested_about(Vec3::new(-300.0, 0.0, 200.0), 200.0);
+        }
         let tracked = TrackedMedium::new(medium, 1 << 15);
+        assert_eq!(tracked.grid.level_count(), if nested { 5 } else { 1 });
         let (mut in_medium, mut tightness) = (0, 0.0f64);
         for p in query_points(&particles, 60_000, 4) {
             let sigma = tracked.medium.extinction_per_m(p);
@@ -151,7 +177,7 @@ fn majorants_bound_the_extinction() {
         }
         assert!(in_medium > 20_000, "{style:?}: {in_medium}");
         eprintln!(
-            "{style:?}: mean extinction / majorant {:.3}, mean majorant {:.4} m^-1",
+            "{style:?} (nested {nested}): mean extinction / majorant {:.3}, mean majorant {:.4} m^-1",
             tightness / in_medium as f64,
             tracked.grid.mean_majorant_per_m()
         );
@@ -171,6 +197,31 @@ fn majorants_bound_the_extinction() {
                     sigma <= bound,
                     "{style:?} at {q} in {b:?}: {sigma} > {bound}"
                 );
+            }
+        }
+        // Along rays, the walk's stretches come in order and bound the extinction at every
+        // point of the ray with medium (the nested levels' stretches included).
+        let mut rng = Rng::for_sample(10, 0, 0);
+        for _ in 0..200 {
+            let origin = Vec3::new(-3000.0, 0.0, -3000.0) + rng.next_vec3() * 6000.0;
+            let target = point_in(&tracked.grid.bounds(), &mut rng);
+            let dir = (target - origin).normalize();
+            let mut segments = Vec::new();
+            let _: std::ops::ControlFlow<()> = tracked.grid.walk(origin, dir, 1e4, |s| {
+                segments.push(s);
+                std::ops::ControlFlow::Continue(())
+            });
+            assert!(segments.windows(2).all(|w| w[0].end <= w[1].start));
+            for _ in 0..100 {
+                let t = rng.next_f32() * 1e4;
+                let sigma = tracked.medium.extinction_per_m(origin + dir * t);
+                if sigma > 0.0 {
+                    let bound = segments
+                        .iter()
+                        .find(|s| s.start <= t && t <= s.end)
+                        .map_or(0.0, |s| s.majorant_per_m);
+                    assert!(sigma <= bound, "{style:?} at t {t}: {sigma} > {bound}");
+                }
             }
         }
         // Nothing outside the particles' bounds.
