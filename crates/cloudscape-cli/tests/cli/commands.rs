@@ -140,34 +140,53 @@ fn export_writes_a_mitsuba_scene_and_a_readable_grid() {
     assert!(grid.max_value() > 0.0, "the exported grid is empty");
 }
 
+/// `bench --techniques raymarch,particles --json`: one report per technique, each with its passes
+/// (where the adapter times them) and frame wall time, the particles' with their count.
 #[test]
 fn bench_json_reports_each_pass_and_the_frame_wall_time() {
     let scratch = Scratch::new("bench");
     let mut args = vec!["bench", "--frames", "2", "--warmup", "0", "--json"];
+    args.extend(["--techniques", "raymarch,particles"]);
+    args.extend(["--set", "particles.table_resolution=low"]);
     args.extend(TINY);
     let run = cloudscape(scratch.path(), &args, true);
     assert!(run.success, "{}", run.stderr);
-    let report: serde_json::Value = serde_json::from_str(&run.stdout).expect("JSON on stdout");
-    assert_eq!(report["frames"], 2);
-    assert_eq!(
-        (report["width"].as_u64(), report["height"].as_u64()),
-        (Some(64), Some(36))
-    );
-    let passes: Vec<&str> = report["passes"]
-        .as_array()
-        .expect("a passes array")
-        .iter()
-        .filter_map(|pass| pass["name"].as_str())
-        .collect();
-    let expected: &[&str] = match report["timestamps"].as_bool() {
-        Some(true) => &["raymarch", "compose", "display"],
-        _ => &[],
-    };
-    assert_eq!(passes, expected);
-    let wall_ms = report["frame_wall"]["mean_ms"]
-        .as_f64()
-        .expect("frame_wall.mean_ms");
-    assert!(wall_ms > 0.0, "{report}");
+    let reports: serde_json::Value = serde_json::from_str(&run.stdout).expect("JSON on stdout");
+    let reports = reports.as_array().expect("one report per technique");
+    assert_eq!(reports.len(), 2);
+    for (report, technique) in reports.iter().zip(["raymarch", "particles"]) {
+        assert_eq!(report["technique"], technique);
+        assert_eq!(report["frames"], 2);
+        assert_eq!(
+            (report["width"].as_u64(), report["height"].as_u64()),
+            (Some(64), Some(36))
+        );
+        let passes: Vec<&str> = report["passes"]
+            .as_array()
+            .expect("a passes array")
+            .iter()
+            .filter_map(|pass| pass["name"].as_str())
+            .collect();
+        let expected: &[&str] = match (report["timestamps"].as_bool(), technique) {
+            (Some(true), "raymarch") => &["raymarch", "compose", "display"],
+            (Some(true), _) => &[
+                "particles: generate",
+                "particles: bin",
+                "particles: render",
+                "upsample",
+                "compose",
+                "display",
+            ],
+            _ => &[],
+        };
+        assert_eq!(passes, expected);
+        let wall_ms = report["frame_wall"]["mean_ms"]
+            .as_f64()
+            .expect("frame_wall.mean_ms");
+        assert!(wall_ms > 0.0, "{report}");
+    }
+    assert!(reports[0]["primitives"].is_null());
+    assert!(reports[1]["primitives"].as_u64().is_some_and(|n| n > 1000));
     assert!(scratch.file_names().is_empty(), "bench wrote a file");
 }
 
