@@ -186,6 +186,17 @@ mod tests {
             76_096,
             "peers.md: 76,096 cells"
         );
+        assert_eq!(
+            g.cell_layers, 12,
+            "cells as tall as wide across the 2200 m band"
+        );
+        let mut yusov = Scene::default();
+        yusov.layers[0].thickness_m = 700.0;
+        assert_eq!(
+            RingGrid::from_scene(&yusov).cell_layers,
+            4,
+            "Yusov's 4 over 700 m"
+        );
     }
 
     /// Sum of the weights of every ring's particles at a point: 1 wherever the grid reaches, for
