@@ -5,12 +5,10 @@
 //! `cargo run --release -p cloudscape-reference --example particle_set_speed [spp] [seconds] [both|field|particles]`
 //! (`REACH=metres` keeps only the particles whose centres are that close to the camera).
 
-use cloudscape::environment::Environment;
 use cloudscape::field::CloudField;
 use cloudscape::particles::ParticleTableSpec;
 use cloudscape::particles::density::RadialProfile;
 use cloudscape::particles::generate::{self, Generation};
-use cloudscape::particles::grid::RingGrid;
 use cloudscape::scene::Scene;
 use cloudscape_reference::geometry::Aabb;
 use cloudscape_reference::medium::Medium;
@@ -100,15 +98,8 @@ fn main() {
     let field = CloudField::new(&scene, Path::new("")).expect("the default scene");
     field.bake_noise();
     let spec = ParticleTableSpec::from_scene(&scene);
-    let generation = Generation {
-        grid: RingGrid::from_scene(&scene),
-        camera_m: Vec3::from_array(scene.camera.position_m),
-        sun_direction: Environment::from_scene(&scene).sun.direction,
-        time_s: scene.render.time_s,
-        sigma_max_per_m: spec.extinction_per_m,
-        particle_mean_density: RadialProfile::of(&spec.particle).volume_mean(),
-        occlusion_early_exit: scene.particles.occlusion_early_exit,
-    };
+    let generation =
+        Generation::from_scene(&scene, RadialProfile::of(&spec.particle).volume_mean());
     let start = Instant::now();
     let mut particles = generate::generate(&field, &generation);
     if let Some(reach) = std::env::var("REACH")

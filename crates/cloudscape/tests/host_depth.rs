@@ -83,14 +83,14 @@ fn clouds_over_depth(
 
 /// Geometry 500 m away hides all of the layer, which starts 1500 m up; an empty depth buffer
 /// shows it.
-fn geometry_hides_the_clouds(technique: Technique) {
+fn geometry_hides_the_clouds(technique: Technique, max_clear_transmittance: f32) {
     for convention in DepthConvention::ALL {
         let (radiance, transmittance) = clouds_over_depth(convention, Some(500.0), technique);
         assert_eq!(radiance, 0.0, "{technique:?} {convention:?}");
         assert_eq!(transmittance, 1.0, "{technique:?} {convention:?}");
         let (radiance, transmittance) = clouds_over_depth(convention, None, technique);
         assert!(
-            radiance > 0.0 && transmittance < 0.95,
+            radiance > 0.0 && transmittance < max_clear_transmittance,
             "{technique:?} {convention:?}: an empty depth buffer shows the clouds: T = {transmittance}"
         );
     }
@@ -98,14 +98,15 @@ fn geometry_hides_the_clouds(technique: Technique) {
 
 #[test]
 fn geometry_in_front_of_the_layer_hides_the_clouds_in_every_depth_convention() {
-    geometry_hides_the_clouds(Technique::Raymarch);
+    geometry_hides_the_clouds(Technique::Raymarch, 0.8);
 }
 
 /// The particles render at half resolution: the coarse grid takes the farthest depth of each
 /// block, and the shared upsampling zeroes the weight of cloud behind a pixel's geometry.
 #[test]
 fn particles_respect_the_depth_buffer_through_the_upsampling() {
-    geometry_hides_the_clouds(Technique::Particles);
+    // The particles' coarser clouds let more light through the same sky.
+    geometry_hides_the_clouds(Technique::Particles, 0.95);
 }
 
 #[test]

@@ -8,7 +8,6 @@ use cloudscape::gpu::readback::read_texture_rgba16f;
 use cloudscape::output::CloudOutput;
 use cloudscape::particles::generate::{self, Generation, Particle};
 use cloudscape::particles::generate_gpu::GenerationCounts;
-use cloudscape::particles::grid::RingGrid;
 use cloudscape::particles::render::ParticleRenderer;
 use cloudscape::particles::{ParticleTableSpec, density::RadialProfile};
 use cloudscape::renderer::{CloudRenderer, Reuse};
@@ -87,17 +86,9 @@ fn small_grid_scene(overrides: &[&str]) -> Scene {
 }
 
 fn cpu_generation(scene: &Scene, field_mean: f32, early_exit: bool) -> Generation {
-    let spec = ParticleTableSpec::from_scene(scene);
     Generation {
-        grid: RingGrid::from_scene(scene),
-        camera_m: Vec3::from_array(scene.camera.position_m),
-        sun_direction: cloudscape::environment::Environment::from_scene(scene)
-            .sun
-            .direction,
-        time_s: scene.render.time_s,
-        sigma_max_per_m: spec.extinction_per_m,
-        particle_mean_density: field_mean,
         occlusion_early_exit: early_exit,
+        ..Generation::from_scene(scene, field_mean)
     }
 }
 

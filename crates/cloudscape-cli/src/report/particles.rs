@@ -9,17 +9,15 @@
 use super::{ReportArgs, cached_trace};
 use crate::compare::Comparison;
 use anyhow::{Result, anyhow};
-use cloudscape::environment::Environment;
 use cloudscape::gpu::GpuContext;
 use cloudscape::image::{HdrImage, write_image};
 use cloudscape::particles::ParticleTableSpec;
 use cloudscape::particles::density::RadialProfile;
 use cloudscape::particles::generate::{self, Generation};
-use cloudscape::particles::grid::RingGrid;
 use cloudscape::renderer::SceneRenderer;
 use cloudscape::scene::{SceneDocument, Technique};
 use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer};
-use glam::{UVec2, Vec3};
+use glam::UVec2;
 use std::fmt::Write as _;
 use std::hash::{Hash, Hasher};
 use std::path::Path;
@@ -57,15 +55,8 @@ pub fn row(
     let gpu = renderer.render(ctx, &scene, |_| {});
     let gpu_ms = start.elapsed().as_secs_f64() * 1e3;
     let spec = ParticleTableSpec::from_scene(&scene);
-    let generation = Generation {
-        grid: RingGrid::from_scene(&scene),
-        camera_m: Vec3::from_array(scene.camera.position_m),
-        sun_direction: Environment::from_scene(&scene).sun.direction,
-        time_s: scene.render.time_s,
-        sigma_max_per_m: spec.extinction_per_m,
-        particle_mean_density: RadialProfile::of(&spec.particle).volume_mean(),
-        occlusion_early_exit: scene.particles.occlusion_early_exit,
-    };
+    let generation =
+        Generation::from_scene(&scene, RadialProfile::of(&spec.particle).volume_mean());
     let particles = generate::generate(renderer.field(), &generation);
     if particles.is_empty() {
         return Ok(None);

@@ -12,9 +12,10 @@
 //! dissipates (Yusov: "clouds are animated by changing particle size and transparency").
 
 use super::grid::{CELL_JITTER, Column, RingGrid, smoothstep};
+use crate::environment::Environment;
 use crate::field::noise::{hash_to_unit, pcg_hash};
 use crate::field::{CloudField, GOLDEN_RATIO_CONJUGATE};
-use crate::scene::PlanetShape;
+use crate::scene::{PlanetShape, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
@@ -82,6 +83,23 @@ pub struct Generation {
     pub particle_mean_density: f32,
     /// Whether the march toward the sun stops at [`OCCLUSION_MAX_DEPTH`].
     pub occlusion_early_exit: bool,
+}
+
+impl Generation {
+    /// What `scene` asks for: its grid, camera, sun, time, early exit and the peak extinction of
+    /// its particle tables, for a reference particle of mean density `particle_mean_density`
+    /// (`ParticleTables::mean_density`, or [`super::density::RadialProfile::volume_mean`]).
+    pub fn from_scene(scene: &Scene, particle_mean_density: f32) -> Generation {
+        Generation {
+            grid: RingGrid::from_scene(scene),
+            camera_m: Vec3::from_array(scene.camera.position_m),
+            sun_direction: Environment::from_scene(scene).sun.direction,
+            time_s: scene.render.time_s,
+            sigma_max_per_m: super::ParticleTableSpec::from_scene(scene).extinction_per_m,
+            particle_mean_density,
+            occlusion_early_exit: scene.particles.occlusion_early_exit,
+        }
+    }
 }
 
 /// A listed column and the mask of its layers that hold cloud.

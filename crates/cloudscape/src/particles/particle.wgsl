@@ -89,6 +89,21 @@ fn particle_rotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
     return v + q.w * t + cross(q.xyz, t);
 }
 
+// One particle of the technique (generate.rs Particle): an ellipsoid of the reference particle,
+// written by particle_generate.wgsl and read by particle_render.wgsl.
+struct Particle {
+    centre_m: vec3<f32>,
+    radius_m: f32,          // horizontal radius
+    height_m: f32,          // vertical radius
+    density: f32,           // peak density relative to the reference particle's, fade included
+    sun_optical_depth: f32, // light occlusion
+    id: u32,                // stable: seeds jitter, size and rotation
+    optical_depth_up: f32,  // the field's, up to the band's top
+    optical_depth_down: f32,// the field's, down to the band's floor
+    ring: u32,
+    reserved: u32,
+}
+
 // A style's constants: the noise's first-octave cells per radius and three style parameters.
 struct ParticleShape {
     base_cells: f32,

@@ -1,4 +1,4 @@
-#import field noise frame environment
+#import field noise frame environment particle
 // Particle generation on the GPU: the twin of particles/grid.rs and particles/generate.rs, line for
 // line (see there for the sources). Three entry points, dispatched in order each frame:
 // `list_cells` (one invocation per grid column: the seed's append buffer of non-empty cells),
@@ -23,19 +23,6 @@ struct Generation {
 struct ListedCell {
     column: u32,
     layers: u32, // bit l: layer l holds a particle
-}
-
-struct Particle {
-    centre_m: vec3<f32>,
-    radius_m: f32,
-    height_m: f32,
-    density: f32,
-    sun_optical_depth: f32,
-    id: u32,
-    optical_depth_up: f32,
-    optical_depth_down: f32,
-    ring: u32,
-    reserved: u32,
 }
 
 // [0] listed cells, [1] particles, [2] occlusion segments marched, [3] particles beyond capacity.

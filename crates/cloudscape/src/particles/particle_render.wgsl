@@ -24,19 +24,6 @@ struct Render {
     band_rows: vec2<u32>,          // texel rows [x, y) this dispatch writes
 }
 
-struct Particle {
-    centre_m: vec3<f32>,
-    radius_m: f32,
-    height_m: f32,
-    density: f32,
-    sun_optical_depth: f32,
-    id: u32,
-    optical_depth_up: f32,
-    optical_depth_down: f32,
-    ring: u32,
-    reserved: u32,
-}
-
 @group(3) @binding(0) var<uniform> render: Render;
 @group(3) @binding(1) var<storage, read> particles: array<Particle>;
 // particle_generate.wgsl's counts: [1] particles made.

@@ -6,13 +6,12 @@
 //! serve it unchanged.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{UVec2, Vec3, Vec4};
+use glam::{UVec2, Vec4};
 
 use super::ParticleTableSpec;
 use super::blend::Blending;
 use super::generate::{Generation, Particle};
 use super::generate_gpu::{GenerationCounts, MAX_PARTICLES, ParticleGenerator, set_groups};
-use super::grid::RingGrid;
 use super::store::TableStore;
 use super::tables_gpu::ParticleTables;
 use crate::frame::{Shared, SharedSlots};
@@ -290,16 +289,7 @@ impl Technique for ParticleRenderer {
     fn prepare(&mut self, ctx: &GpuContext, scene: &Scene) {
         let tables = self.load_tables(ctx, scene);
         let settings = Self::uniform(scene, tables);
-        let environment = crate::environment::Environment::from_scene(scene);
-        let generation = Generation {
-            grid: RingGrid::from_scene(scene),
-            camera_m: Vec3::from_array(scene.camera.position_m),
-            sun_direction: environment.sun.direction,
-            time_s: scene.render.time_s,
-            sigma_max_per_m: tables.spec.extinction_per_m,
-            particle_mean_density: tables.mean_density,
-            occlusion_early_exit: scene.particles.occlusion_early_exit,
-        };
+        let generation = Generation::from_scene(scene, tables.mean_density);
         self.settings = settings;
         self.generation = Some(generation);
         self.generated = false;
@@ -319,10 +309,11 @@ impl Technique for ParticleRenderer {
             self.generator = Some(ParticleGenerator::new(ctx, shared, &generation));
             self.group.clear();
         }
-        let generator = self.generator.as_ref().expect("made above");
-        generator.set(ctx, &generation);
-        if let Some(particles) = &self.supplied {
-            if !self.generated {
+        // Once a frame, not once a band: the particles are made by the frame's first band.
+        if !self.generated {
+            let generator = self.generator.as_ref().expect("made above");
+            generator.set(ctx, &generation);
+            if let Some(particles) = &self.supplied {
                 generator.upload(ctx, particles);
             }
         }
