@@ -30,5 +30,6 @@ pub mod raymarch;
 pub mod renderer;
 pub mod scene;
 pub mod shader;
+pub mod sprites;
 pub mod technique;
 pub mod temporal;

@@ -61,6 +61,16 @@ pub const MODULES: &[WgslModule] = &[
         "particle_render",
         include_str!("particles/particle_render.wgsl"),
     ),
+    module("sprite", include_str!("sprites/sprite.wgsl")),
+    module("sprite_render", include_str!("sprites/sprite_render.wgsl")),
+    module(
+        "sprite_impostor",
+        include_str!("sprites/sprite_impostor.wgsl"),
+    ),
+    module(
+        "sprite_resolve",
+        include_str!("sprites/sprite_resolve.wgsl"),
+    ),
 ];
 
 /// The modules with entry points: every pipeline the crate builds starts from one of these.
@@ -75,6 +85,9 @@ pub const PROGRAMS: &[&str] = &[
     "particle_bake",
     "particle_generate",
     "particle_render",
+    "sprite_render",
+    "sprite_impostor",
+    "sprite_resolve",
 ];
 
 /// Bind group slots shared by every program: the field, the frame, the environment; each pass

@@ -5,9 +5,10 @@
 //! [`crate::output::SampleGrid`]. It never draws the sky, applies haze, tone-maps or keeps history:
 //! temporal reuse, upsampling and compositing serve every technique from its output.
 
-use crate::frame::Shared;
+use crate::field::CloudField;
+use crate::frame::{Frame, Shared};
 use crate::gpu::{GpuContext, PassTimer};
-use crate::output::CloudOutput;
+use crate::output::{CloudOutput, SampleGrid};
 use crate::scene::Scene;
 use glam::UVec2;
 
@@ -21,6 +22,21 @@ pub struct TechniqueStats {
     pub density_samples_per_pixel: f64,
     /// Primitives drawn (particles, sprites); None for techniques without them.
     pub primitives: Option<u32>,
+}
+
+/// What a frame is made of, on the CPU: the scene's settings, the field they describe, the view
+/// and the sample grid of the output. Techniques that work on the CPU (sorting, generating
+/// sprites) read the camera here, as the host set it.
+#[derive(Clone, Copy)]
+pub struct FrameInputs<'a> {
+    /// This frame's scene (steps, lighting, sun, time).
+    pub scene: &'a Scene,
+    /// The cloud field (the CPU specification).
+    pub field: &'a CloudField,
+    /// The host's camera, projection, depth convention and time.
+    pub frame: &'a Frame,
+    /// The rays the output holds.
+    pub grid: &'a SampleGrid,
 }
 
 /// Where a technique reads and writes.
@@ -47,8 +63,8 @@ pub trait Technique {
         1
     }
 
-    /// Takes this frame's settings (steps, lighting, phase function) from `scene`.
-    fn prepare(&mut self, ctx: &GpuContext, scene: &Scene);
+    /// Takes this frame's settings (steps, lighting, phase function) and view.
+    fn prepare(&mut self, ctx: &GpuContext, inputs: &FrameInputs);
 
     /// Records the technique over the output texels `region` (origin, size): the whole output, or
     /// one band of it when a long render reports progress (then submit each band before encoding

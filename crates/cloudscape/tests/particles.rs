@@ -5,14 +5,14 @@ use cloudscape::frame::Frame;
 use cloudscape::gpu::GpuContext;
 use cloudscape::gpu::pipeline::{clear_depth, texture_2d};
 use cloudscape::gpu::readback::read_texture_rgba16f;
-use cloudscape::output::CloudOutput;
+use cloudscape::output::{CloudOutput, SampleGrid};
 use cloudscape::particles::generate::{self, Generation, Particle};
 use cloudscape::particles::generate_gpu::GenerationCounts;
 use cloudscape::particles::render::ParticleRenderer;
 use cloudscape::particles::{ParticleTableSpec, density::RadialProfile};
 use cloudscape::renderer::{CloudRenderer, Reuse};
 use cloudscape::scene::{Scene, SceneDocument};
-use cloudscape::technique::{Technique, TechniqueTargets};
+use cloudscape::technique::{FrameInputs, Technique, TechniqueTargets};
 use glam::{UVec2, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
@@ -49,7 +49,13 @@ impl Harness {
     /// transmittance per texel.
     fn render(&mut self, ctx: &GpuContext, scene: &Scene, frame: &Frame) -> Vec<[f32; 4]> {
         self.clouds.begin_frame(ctx, scene, frame, Reuse::None);
-        self.particles.prepare(ctx, scene);
+        let inputs = FrameInputs {
+            scene,
+            field: self.clouds.field(),
+            frame,
+            grid: &SampleGrid::FULL,
+        };
+        self.particles.prepare(ctx, &inputs);
         let targets = TechniqueTargets {
             host_depth: &self.depth,
             output: &self.output,

@@ -254,15 +254,19 @@ fn the_embedded_default_is_the_default_scene() {
 }
 
 #[test]
-fn a_technique_not_built_yet_is_located_and_lists_the_built_ones() {
+fn a_sprite_cloud_without_boxes_is_located() {
     let error = rejected(
-        "[render]\ntechnique = \"sprites\"\n",
-        2,
-        13,
-        "render.technique",
+        "[[sprite_clouds]]\ntype = \"stratus\"\ncenter_m = [0.0, 900.0, 0.0]\nboxes = []\n",
+        4,
+        9,
+        "sprite_clouds.0.boxes",
     );
-    assert_mentions(
-        &error,
-        &["sprites", "not built yet", "built: raymarch, particles"],
+    assert_mentions(&error, &["at least one box"]);
+    let error = rejected(
+        "[[sprite_clouds]]\ntype = \"cumulus_congestus\"\ncenter_m = [0.0, 900.0, 0.0]\nboxes = [{ center_m = [0.0, 0.0, 0.0], size_m = [100.0, -1.0, 100.0] }]\n",
+        4,
+        71,
+        "sprite_clouds.0.boxes.0.size_m.1",
     );
+    assert_mentions(&error, &["> 0"]);
 }

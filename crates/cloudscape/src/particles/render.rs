@@ -25,7 +25,7 @@ use crate::gpu::{GpuContext, PassTimer};
 use crate::optics::PhaseLobes;
 use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
 use crate::scene::{PlanetShape, Scene};
-use crate::technique::{Technique, TechniqueStats, TechniqueTargets};
+use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 
 /// Output texels along each side of a screen tile (`TILE` in `particle_render.wgsl`).
 pub const TILE_TEXELS: u32 = 16;
@@ -286,7 +286,8 @@ impl Technique for ParticleRenderer {
         scene.particles.resolution_divisor
     }
 
-    fn prepare(&mut self, ctx: &GpuContext, scene: &Scene) {
+    fn prepare(&mut self, ctx: &GpuContext, inputs: &FrameInputs) {
+        let scene = inputs.scene;
         let tables = self.load_tables(ctx, scene);
         let settings = Self::uniform(scene, tables);
         let generation = Generation::from_scene(scene, tables.mean_density);

@@ -14,7 +14,7 @@ use crate::gpu::pipeline::{
 use crate::optics::PhaseLobes;
 use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
 use crate::scene::{Quality, Scene};
-use crate::technique::{Technique, TechniqueStats, TechniqueTargets};
+use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, Vec4};
 
@@ -209,7 +209,8 @@ impl Technique for RaymarchRenderer {
         &["raymarch"]
     }
 
-    fn prepare(&mut self, ctx: &GpuContext, scene: &Scene) {
+    fn prepare(&mut self, ctx: &GpuContext, inputs: &FrameInputs) {
+        let scene = inputs.scene;
         self.set_settings(ctx, &MarchSettings::from_scene(scene));
     }
 

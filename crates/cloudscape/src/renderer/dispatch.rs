@@ -1,36 +1,30 @@
 //! The one place that knows every technique: builds the one a scene names.
 
+use std::path::Path;
+
 use crate::field::FieldError;
 use crate::frame::Shared;
 use crate::gpu::GpuContext;
 use crate::particles::render::ParticleRenderer;
 use crate::raymarch::RaymarchRenderer;
-use crate::scene::Technique as TechniqueName;
+use crate::scene::{Scene, Technique as TechniqueName};
+use crate::sprites::SpriteRenderer;
 use crate::technique::Technique;
 
-/// The technique `name` (`render.technique`), built against the shared groups; an error naming
-/// the built ones for a technique that is not (scene files never get here: validation rejects
-/// them with a located error, but a scene made in code can).
+/// The technique `scene` names (`render.technique`), built against the shared groups; files it
+/// reads (a sprite model) resolve against `base_dir`, and one that cannot be read is an error at
+/// its scene key.
 pub fn build(
     ctx: &GpuContext,
     shared: &Shared,
-    name: TechniqueName,
+    scene: &Scene,
+    base_dir: &Path,
 ) -> Result<Box<dyn Technique>, FieldError> {
-    match name {
-        TechniqueName::Raymarch => Ok(Box::new(RaymarchRenderer::new(ctx, shared))),
-        TechniqueName::Particles => Ok(Box::new(ParticleRenderer::new(ctx, shared))),
-        TechniqueName::Sprites => {
-            let built: Vec<&str> = TechniqueName::BUILT.iter().map(|t| t.name()).collect();
-            Err(FieldError {
-                key_path: "render.technique".into(),
-                message: format!(
-                    "{:?} is not built yet; built: {}",
-                    name.name(),
-                    built.join(", ")
-                ),
-            })
-        }
-    }
+    Ok(match scene.render.technique {
+        TechniqueName::Raymarch => Box::new(RaymarchRenderer::new(ctx, shared)),
+        TechniqueName::Particles => Box::new(ParticleRenderer::new(ctx, shared)),
+        TechniqueName::Sprites => Box::new(SpriteRenderer::new(ctx, shared, scene, base_dir)?),
+    })
 }
 
 #[cfg(test)]
@@ -38,10 +32,10 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_built_technique_is_dispatched_under_its_name() {
+    fn every_technique_is_dispatched_under_its_name() {
         let ctx = GpuContext::for_tests();
-        let scene = crate::scene::Scene::default();
-        let field = crate::field::CloudField::new(&scene, std::path::Path::new(".")).unwrap();
+        let mut scene = Scene::default();
+        let field = crate::field::CloudField::new(&scene, Path::new(".")).unwrap();
         let field_gpu = crate::field::gpu::FieldGpu::new(&ctx, &field);
         let frame = crate::frame::FrameGpu::new(&ctx, "frame");
         let environment = crate::environment::EnvironmentGpu::new(&ctx, "environment");
@@ -50,14 +44,18 @@ mod tests {
             frame: &frame,
             environment: &environment,
         };
-        for name in TechniqueName::BUILT {
-            assert_eq!(build(&ctx, &shared, *name).unwrap().name(), name.name());
+        for name in TechniqueName::ALL {
+            scene.render.technique = *name;
+            let built = build(&ctx, &shared, &scene, Path::new(".")).unwrap();
+            assert_eq!(built.name(), name.name());
         }
-        let error = build(&ctx, &shared, TechniqueName::Sprites)
+        scene.sprites.model = Some("no-such-model.toml".into());
+        let error = build(&ctx, &shared, &scene, Path::new("."))
             .err()
-            .expect("not built");
+            .expect("no file");
+        assert_eq!(error.key_path, "sprites.model");
         assert!(
-            error.message.contains("built: raymarch, particles"),
+            error.message.contains("no-such-model.toml"),
             "{}",
             error.message
         );

@@ -17,7 +17,7 @@ use crate::output::{CloudOutput, SampleGrid};
 use crate::post::upsample::Upsampler;
 use crate::post::{Background, Compositor, DISPLAY_FORMAT, Display, HDR_FORMAT};
 use crate::scene::Scene;
-use crate::technique::{Technique, TechniqueStats, TechniqueTargets};
+use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use crate::temporal::{TemporalResolve, TemporalSettings};
 use glam::{UVec2, Vec2};
 use std::path::Path;
@@ -105,7 +105,7 @@ impl CloudRenderer {
             frame: &frame_gpu,
             environment: &environment_gpu,
         };
-        let technique = dispatch::build(ctx, &shared, scene.render.technique)?;
+        let technique = dispatch::build(ctx, &shared, scene, base_dir)?;
         let compositor = Compositor::new(ctx, &shared);
         let upsampler = Upsampler::new(ctx, &shared);
         Ok(CloudRenderer {
@@ -136,8 +136,10 @@ impl CloudRenderer {
     ) -> Result<FieldUpdate, FieldError> {
         self.field = CloudField::new(scene, base_dir)?;
         let update = self.field_gpu.update(ctx, &self.field);
-        if self.technique.name() != scene.render.technique.name() {
-            self.technique = dispatch::build(ctx, &self.shared(), scene.render.technique)?;
+        // Sprite clouds are made from the field and the scene's hand-made clouds: remade too.
+        let sprites = scene.render.technique == crate::scene::Technique::Sprites;
+        if sprites || self.technique.name() != scene.render.technique.name() {
+            self.technique = dispatch::build(ctx, &self.shared(), scene, base_dir)?;
         }
         self.reset_history();
         Ok(update)
@@ -225,7 +227,13 @@ impl CloudRenderer {
         self.frame_gpu.write(ctx, &frame.uniform(&grid));
         let environment = EnvironmentUniform::new(&Environment::from_scene(scene));
         self.environment_gpu.write(ctx, &environment);
-        self.technique.prepare(ctx, scene);
+        let inputs = FrameInputs {
+            scene,
+            field: &self.field,
+            frame,
+            grid: &grid,
+        };
+        self.technique.prepare(ctx, &inputs);
         self.frame = Some(frame.clone());
         self.reuse = reuse;
     }

@@ -3,7 +3,7 @@
 
 use std::ops::Range;
 
-use serde::Deserialize;
+use serde::de::DeserializeOwned;
 use toml::Spanned;
 use toml::de::{DeTable, Deserializer};
 
@@ -12,10 +12,21 @@ use super::{Scene, SceneError, key_path, locate, overrides, validate};
 
 /// Builds the scene described by `sources`: the file with its overrides applied, checked.
 pub(super) fn scene(sources: &SourceMap) -> Result<Scene, SceneError> {
+    document(sources, |scene| {
+        validate::validate(scene).map_err(|v| (v.key, v.message))
+    })
+}
+
+/// Builds the `T` that `sources` describe, checked by `check` (which names the dotted key of the
+/// first bad value and what is wrong with it); every error located.
+pub(super) fn document<T: DeserializeOwned>(
+    sources: &SourceMap,
+    check: impl Fn(&T) -> Result<(), (String, String)>,
+) -> Result<T, SceneError> {
     let root = merged_document(sources)?;
-    let scene = deserialize(&root, sources)?;
-    validate::validate(&scene).map_err(|v| error_at(Some(&root), sources, &v.key, v.message))?;
-    Ok(scene)
+    let value = deserialize(&root, sources)?;
+    check(&value).map_err(|(key, message)| error_at(Some(&root), sources, &key, message))?;
+    Ok(value)
 }
 
 /// The file's document with every override applied; spans index the address space of `sources`.
@@ -68,9 +79,12 @@ fn syntax_error_key(root: &DeTable<'_>, text: &str, span: &Range<usize>) -> Opti
 
 /// Deserialises the merged document; unknown keys, wrong types and unknown enum strings are
 /// reported at their span with the key path they are at.
-fn deserialize(root: &DeTable<'_>, sources: &SourceMap) -> Result<Scene, SceneError> {
+fn deserialize<T: DeserializeOwned>(
+    root: &DeTable<'_>,
+    sources: &SourceMap,
+) -> Result<T, SceneError> {
     let deserializer = Deserializer::from(Spanned::new(0..0, root.clone()));
-    Scene::deserialize(deserializer).map_err(|error| {
+    T::deserialize(deserializer).map_err(|error| {
         let key = error.span().and_then(|span| locate::path_at(root, &span));
         sources.error(error.span(), key, plain_words(error.message()))
     })

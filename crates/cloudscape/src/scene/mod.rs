@@ -20,6 +20,18 @@ pub use error::SceneError;
 pub use model::*;
 use source_map::SourceMap;
 
+/// Parses a TOML document other than a scene (a sprite model file) with the scene's located
+/// errors: syntax, unknown keys and wrong types at their line and column, and what `check` finds
+/// (the dotted key of the first bad value and what is wrong) at the value. `origin` names the
+/// file in messages.
+pub fn parse_toml_document<T: serde::de::DeserializeOwned>(
+    text: &str,
+    origin: &str,
+    check: impl Fn(&T) -> Result<(), (String, String)>,
+) -> Result<T, SceneError> {
+    load::document(&SourceMap::new(origin, text, &[]), check)
+}
+
 /// The embedded default scene: a commented TOML file restating every field of [`Scene::default`].
 pub const DEFAULT_SCENE_TOML: &str = include_str!("default.toml");
 

@@ -37,6 +37,11 @@ pub struct Scene {
     pub lighting: Lighting,
     /// The reference particle of the particle technique, whose lighting is precomputed.
     pub particles: Particles,
+    /// The sprite-cluster technique: field clouds, impostor ring, in-cloud lock, shading.
+    pub sprites: Sprites,
+    /// Hand-made sprite clouds, built from boxes (drawn by the sprite technique only).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sprite_clouds: Vec<SpriteCloudSpec>,
     /// Image size, technique, quality, exposure and output.
     pub render: RenderSettings,
     /// Keyframed camera, sun and coverage over scene time; empty (a static scene) by default.
@@ -59,6 +64,8 @@ impl Default for Scene {
             phase: PhaseFunction::default(),
             lighting: Lighting::default(),
             particles: Particles::default(),
+            sprites: Sprites::default(),
+            sprite_clouds: Vec::new(),
             render: RenderSettings::default(),
             animation: Animation::default(),
         }
@@ -557,21 +564,128 @@ impl Default for Particles {
     }
 }
 
+/// The sprite-cluster technique (Wang 2003, "Realistic and Fast Cloud Rendering in Computer
+/// Games", Microsoft Flight Simulator): clouds of 5-50 textured sprites, from the cloud field and
+/// from hand-made boxes, with an octagonal ring of impostors for the distance.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Sprites {
+    /// Build sprite clouds from the cloud field's layers (off: only `sprite_clouds` and `model`).
+    pub field_clouds: bool,
+    /// Side of the wind-borne tiles a field cloud fills, m, 200..20000: the largest a field cloud
+    /// gets.
+    pub cloud_size_m: f32,
+    /// Field clouds are made out to this horizontal distance from the camera, m, 1000..500000;
+    /// they fade out over its last fifth.
+    pub distance_m: f32,
+    /// Radius of the octagonal impostor ring, m, 0..200000 (Wang: a user setting; smaller is
+    /// faster with more anomalies); clouds beyond it are drawn into 8 impostors. 0: no ring.
+    pub ring_radius_m: f32,
+    /// Texels along each impostor's width, 64..2048.
+    pub impostor_texels: u32,
+    /// Level of detail: every sprite of each cloud, or one billboard per cloud (Wang's fallback).
+    pub lod: SpriteLod,
+    /// Sprites nearer the eye than this turn to face along the view, not toward the eye, so they
+    /// do not part as the camera flies through (Wang's lock), m, 0..5000.
+    pub lock_distance_m: f32,
+    /// Replaces the maximum ambient colour (by default the sky's mean radiance times the albedo).
+    pub ambient_color: Option<[f32; 3]>,
+    /// Replaces the maximum directional colour (by default the sun's irradiance times the
+    /// albedo over pi).
+    pub directional_color: Option<[f32; 3]>,
+    /// A sprite model file (`cloudscape export --sprites` writes one) whose clouds are drawn too,
+    /// relative to the scene file.
+    pub model: Option<String>,
+}
+
+impl Default for Sprites {
+    fn default() -> Self {
+        Sprites {
+            field_clouds: true,
+            cloud_size_m: 1500.0,
+            distance_m: 40_000.0,
+            ring_radius_m: 12_000.0,
+            impostor_texels: 512,
+            lod: SpriteLod::Clusters,
+            lock_distance_m: 150.0,
+            ambient_color: None,
+            directional_color: None,
+            model: None,
+        }
+    }
+}
+
+/// How much of each sprite cloud is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpriteLod {
+    /// Every sprite of every cloud.
+    Clusters,
+    /// One billboard per cloud (Wang 2003's fallback for slow machines).
+    Billboards,
+}
+
+/// A hand-made sprite cloud (Wang 2003, "Cloud creation": an artist builds the shape from boxes,
+/// and a script fills them with sprites). Unset artist parameters come from the type's recipe.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpriteCloudSpec {
+    /// The cloud type: `fair_weather`, `cumulus_humilis`, `cumulus_mediocris`,
+    /// `cumulus_congestus`, `cumulonimbus`, `stratocumulus`, `stratus`, `altocumulus`,
+    /// `altostratus` or `nimbostratus`.
+    #[serde(rename = "type")]
+    pub cloud_type: crate::sprites::CloudType,
+    /// Centre of the cloud, m.
+    pub center_m: [f32; 3],
+    /// The boxes, relative to the centre; at least one.
+    pub boxes: Vec<SpriteBoxSpec>,
+    /// Seed of the sprite placement.
+    #[serde(default)]
+    pub seed: u32,
+    /// Candidate sprites before culling, 1..1000 (the type's by default).
+    #[serde(default)]
+    pub sprites: Option<u32>,
+    /// Sprite width range as fractions of the cloud's height, each 0.01..10.
+    #[serde(default)]
+    pub width: Option<[f32; 2]>,
+    /// Sprite rotation range, degrees, each -180..180.
+    #[serde(default)]
+    pub rotation_deg: Option<[f32; 2]>,
+    /// Five colour levels `[height 0..1, r, g, b, a]` from the bottom up (derived from physics
+    /// by default); rgb 0..4, a 0..1.
+    #[serde(default)]
+    pub color_levels: Option<Vec<[f32; 5]>>,
+}
+
+/// One box of a hand-made sprite cloud.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpriteBoxSpec {
+    /// Centre of the box relative to the cloud's centre, m.
+    pub center_m: [f32; 3],
+    /// Size of the box, m, each > 0.
+    pub size_m: [f32; 3],
+}
+
 /// Which renderer draws the clouds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Technique {
     /// Ray-marched clouds (compute).
     Raymarch,
-    /// Volumetric particles with precomputed lighting (Yusov 2014); not built yet.
+    /// Volumetric particles with precomputed lighting (Yusov 2014).
     Particles,
-    /// Sprite-cluster clouds (Wang 2003); not built yet.
+    /// Sprite-cluster clouds (Wang 2003).
     Sprites,
 }
 
 impl Technique {
-    /// The techniques this build can render (the renderer's dispatch builds each of them).
-    pub const BUILT: &[Technique] = &[Technique::Raymarch, Technique::Particles];
+    /// Every technique, in declaration order.
+    pub const ALL: &[Technique] = &[
+        Technique::Raymarch,
+        Technique::Particles,
+        Technique::Sprites,
+    ];
 
     /// The name scene files use.
     pub fn name(self) -> &'static str {

@@ -6,7 +6,8 @@
 use std::fmt;
 
 use super::model::{
-    CameraKey, CloudLayer, CoverageKey, Scene, SunKey, Technique, VolumeGrid, WeatherSource,
+    CameraKey, CloudLayer, CoverageKey, Scene, SpriteBoxSpec, SpriteCloudSpec, SunKey, VolumeGrid,
+    WeatherSource,
 };
 
 /// A value that breaks a rule, by dotted key path.
@@ -37,7 +38,25 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Violation> {
             VOLUME_RELATIONS,
         )?;
     }
+    validate_sprite_clouds(scene)?;
     validate_animation(scene)
+}
+
+/// Checks every hand-made sprite cloud and each of its boxes.
+fn validate_sprite_clouds(scene: &Scene) -> Result<(), Violation> {
+    for (index, cloud) in scene.sprite_clouds.iter().enumerate() {
+        let prefix = format!("sprite_clouds.{index}.");
+        check(cloud, &prefix, SPRITE_CLOUD_RULES, SPRITE_CLOUD_RELATIONS)?;
+        for (b, sprite_box) in cloud.boxes.iter().enumerate() {
+            check(
+                sprite_box,
+                &format!("{prefix}boxes.{b}."),
+                SPRITE_BOX_RULES,
+                &[],
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// Checks every keyframe of every animation path, then each path's order and consistency.
@@ -105,7 +124,7 @@ enum Field<'a> {
     Absent,
 }
 
-fn optional_floats(value: &Option<[f32; 3]>) -> Field<'_> {
+fn optional_floats<const N: usize>(value: &Option<[f32; N]>) -> Field<'_> {
     value.as_ref().map_or(Field::Absent, |v| Field::Floats(v))
 }
 
@@ -233,6 +252,13 @@ const SCENE_RULES: &[Rule<Scene>] = &[
     rule("particles.cell_layers", Between(0.0, 16.0), "", |s| Int(s.particles.cell_layers)),
     rule("particles.distance_m", Between(1.0e3, 1.0e6), "m", |s| Float(s.particles.distance_m)),
     rule("particles.resolution_divisor", Between(1.0, 4.0), "", |s| Int(s.particles.resolution_divisor)),
+    rule("sprites.cloud_size_m", Between(200.0, 20_000.0), "m", |s| Float(s.sprites.cloud_size_m)),
+    rule("sprites.distance_m", Between(1.0e3, 5.0e5), "m", |s| Float(s.sprites.distance_m)),
+    rule("sprites.ring_radius_m", Between(0.0, 2.0e5), "m", |s| Float(s.sprites.ring_radius_m)),
+    rule("sprites.impostor_texels", Between(64.0, 2048.0), "", |s| Int(s.sprites.impostor_texels)),
+    rule("sprites.lock_distance_m", Between(0.0, 5000.0), "m", |s| Float(s.sprites.lock_distance_m)),
+    rule("sprites.ambient_color", AtLeast(0.0), "", |s| optional_floats(&s.sprites.ambient_color)),
+    rule("sprites.directional_color", AtLeast(0.0), "", |s| optional_floats(&s.sprites.directional_color)),
     rule("render.width", AtLeast(1.0), "px", |s| Int(s.render.width)),
     rule("render.height", AtLeast(1.0), "px", |s| Int(s.render.height)),
     rule("render.primary_steps", Between(1.0, 4096.0), "", |s| optional_int(s.render.primary_steps)),
@@ -260,6 +286,28 @@ const VOLUME_RULES: &[Rule<VolumeGrid>] = &[
     rule("center_m", Finite, "m", |v| Floats(&v.center_m)),
     rule("size_m", Above(0.0), "m", |v| Floats(&v.size_m)),
     rule("extinction_per_m", Between(0.0, 10.0), "m^-1", |v| Float(v.extinction_per_m)),
+];
+
+#[rustfmt::skip]
+const SPRITE_CLOUD_RULES: &[Rule<SpriteCloudSpec>] = &[
+    rule("center_m", Finite, "m", |c| Floats(&c.center_m)),
+    rule("sprites", Between(1.0, 1000.0), "", |c| optional_int(c.sprites)),
+    rule("width", Between(0.01, 10.0), "", |c| optional_floats(&c.width)),
+    rule("rotation_deg", Between(-180.0, 180.0), "deg", |c| optional_floats(&c.rotation_deg)),
+    rule("color_levels", Between(0.0, 4.0), "", |c| Floats(c.color_levels.as_deref().map_or(&[], |l| l.as_flattened()))),
+];
+
+#[rustfmt::skip]
+const SPRITE_BOX_RULES: &[Rule<SpriteBoxSpec>] = &[
+    rule("center_m", Finite, "m", |b| Floats(&b.center_m)),
+    rule("size_m", Above(0.0), "m", |b| Floats(&b.size_m)),
+];
+
+#[rustfmt::skip]
+const SPRITE_CLOUD_RELATIONS: &[Relation<SpriteCloudSpec>] = &[
+    Relation { key: "boxes", broken: no_boxes },
+    Relation { key: "width", broken: width_range_reversed },
+    Relation { key: "color_levels", broken: color_levels_malformed },
 ];
 
 #[rustfmt::skip]
@@ -317,7 +365,6 @@ const SCENE_RELATIONS: &[Relation<Scene>] = &[
     Relation { key: "camera.look_at_m", broken: look_at_is_the_eye },
     Relation { key: "weather.source", broken: weather_file_without_path },
     Relation { key: "render.output", broken: output_not_png_or_exr },
-    Relation { key: "render.technique", broken: technique_not_built },
     Relation { key: "particles.ring_cells", broken: ring_cells_odd },
     Relation { key: "particles.resolution_divisor", broken: divisor_not_1_2_or_4 },
 ];
@@ -332,15 +379,34 @@ const VOLUME_RELATIONS: &[Relation<VolumeGrid>] = &[
     Relation { key: "path", broken: volume_without_path },
 ];
 
-fn technique_not_built(scene: &Scene) -> Option<String> {
-    let technique = scene.render.technique;
-    (!Technique::BUILT.contains(&technique)).then(|| {
-        let built: Vec<&str> = Technique::BUILT.iter().map(|t| t.name()).collect();
-        format!(
-            "{:?} is not built yet; built: {}",
-            technique.name(),
-            built.join(", ")
-        )
+fn no_boxes(cloud: &SpriteCloudSpec) -> Option<String> {
+    cloud.boxes.is_empty().then(|| {
+        "a sprite cloud needs at least one box: boxes = [{ center_m = [..], size_m = [..] }]"
+            .to_string()
+    })
+}
+
+fn width_range_reversed(cloud: &SpriteCloudSpec) -> Option<String> {
+    let [lo, hi] = cloud.width?;
+    (lo > hi).then(|| format!("[{lo}, {hi}] is reversed; give [min, max]"))
+}
+
+fn color_levels_malformed(cloud: &SpriteCloudSpec) -> Option<String> {
+    let levels = cloud.color_levels.as_ref()?;
+    if levels.len() != 5 {
+        return Some(format!(
+            "{} levels given; exactly 5 [height, r, g, b, a] are needed",
+            levels.len()
+        ));
+    }
+    let increasing = levels.windows(2).all(|w| w[0][0] < w[1][0]);
+    let in_range = levels.iter().all(|[h, r, g, b, a]| {
+        (0.0..=1.0).contains(h)
+            && [r, g, b].iter().all(|c| (0.0..=4.0).contains(*c))
+            && (0.0..=1.0).contains(a)
+    });
+    (!increasing || !in_range).then(|| {
+        "levels need heights rising within 0..1, rgb within 0..4 and a within 0..1".to_string()
     })
 }
 
@@ -585,6 +651,28 @@ pub(super) mod tests {
             path: "cloud.vol".into(),
             ..VolumeGrid::default()
         });
+        scene.sprites.ambient_color = Some([0.3, 0.35, 0.45]);
+        scene.sprites.directional_color = Some([2.5, 2.4, 2.2]);
+        scene.sprites.model = Some("clouds.sprites.toml".into());
+        scene.sprite_clouds.push(SpriteCloudSpec {
+            cloud_type: crate::sprites::CloudType::CumulusMediocris,
+            center_m: [0.0, 1800.0, -6000.0],
+            boxes: vec![SpriteBoxSpec {
+                center_m: [0.0; 3],
+                size_m: [1400.0, 500.0, 1000.0],
+            }],
+            seed: 1,
+            sprites: Some(40),
+            width: Some([0.45, 0.8]),
+            rotation_deg: Some([-180.0, 180.0]),
+            color_levels: Some(vec![
+                [0.0, 0.4, 0.4, 0.45, 1.0],
+                [0.25, 0.55, 0.55, 0.6, 1.0],
+                [0.5, 0.7, 0.7, 0.75, 1.0],
+                [0.75, 0.85, 0.85, 0.9, 1.0],
+                [1.0, 1.0, 1.0, 1.0, 1.0],
+            ]),
+        });
         scene.animation = two_key_animation();
         scene
     }
@@ -626,6 +714,8 @@ pub(super) mod tests {
             prefixed("", SCENE_RULES),
             prefixed("layers.", LAYER_RULES),
             prefixed("volumes.", VOLUME_RULES),
+            prefixed("sprite_clouds.", SPRITE_CLOUD_RULES),
+            prefixed("sprite_clouds.boxes.", SPRITE_BOX_RULES),
             prefixed("animation.camera_path.", CAMERA_KEY_RULES),
             prefixed("animation.time_of_day.", SUN_KEY_RULES),
             prefixed("animation.coverage_scale.", COVERAGE_KEY_RULES),

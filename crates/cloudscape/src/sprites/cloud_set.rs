@@ -1,0 +1,329 @@
+//! Every sprite cloud of a scene, kept up to date on the CPU and laid out for the GPU: field clouds
+//! in the tiles around the camera (made as the camera reaches them, kept while it stays near), the
+//! hand-made clouds and those of a model file; each cloud's colour levels and each shading
+//! group's light for the current sun.
+
+use std::collections::BTreeMap;
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Vec2, Vec3, Vec4};
+
+use super::from_field::{FieldTiling, TileKey};
+use super::model::SpriteCloud;
+use super::shading::{self, ColorLevel, LEVELS, SunLight, physical_levels};
+use crate::field::CloudField;
+use crate::particles::DEFAULT_EXTINCTION_PER_M;
+use crate::scene::{Scene, SpriteLod};
+
+/// `layer` of a sprite no wind carries.
+pub const NO_LAYER: u32 = 4;
+/// The sun must turn this far before the groups' light is recomputed, radians (0.2 degrees).
+const SUN_TOLERANCE_RAD: f32 = 0.0035;
+
+/// One sprite as `sprite_render.wgsl` reads it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuSprite {
+    /// Centre at time 0 in its layer's wind frame, m.
+    pub position_m: Vec3,
+    /// The layer whose wind carries it; [`NO_LAYER`]: none.
+    pub layer: u32,
+    /// Width and height, m.
+    pub size_m: Vec2,
+    /// Rotation about the view axis, radians.
+    pub rotation_rad: f32,
+    /// Tile of the puff sheet.
+    pub texture: u32,
+    /// Index of its cloud.
+    pub cloud: u32,
+    /// Opacity 0..1.
+    pub opacity: f32,
+    /// Its group's directional factor, 0..1.
+    pub directional: f32,
+    /// Direct sun reaching its group, 0..1.
+    pub sun_transmittance: f32,
+}
+
+/// One cloud's colour levels and vertical extent as `sprite_render.wgsl` reads them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuCloud {
+    /// Ambient fraction and opacity of each level.
+    pub colors: [Vec4; LEVELS],
+    /// Height fractions of levels 0..3.
+    pub level_heights: Vec4,
+    /// Height fraction of level 4.
+    pub top_level_height: f32,
+    /// World y of the cloud's bottom, m.
+    pub bottom_y_m: f32,
+    /// Bottom to top, m.
+    pub height_m: f32,
+    pad: f32,
+}
+
+impl GpuCloud {
+    fn new(levels: &[ColorLevel; LEVELS], bottom_y_m: f32, height_m: f32) -> GpuCloud {
+        GpuCloud {
+            colors: levels.map(|l| l.rgba),
+            level_heights: Vec4::from_array(std::array::from_fn(|i| levels[i].height)),
+            top_level_height: levels[LEVELS - 1].height,
+            bottom_y_m,
+            height_m,
+            pad: 0.0,
+        }
+    }
+}
+
+/// A cloud with where it came from: the field (its layer's extinction) or an artist (levels given
+/// or derived).
+#[derive(Clone, Debug)]
+struct Placed {
+    cloud: SpriteCloud,
+    levels: Option<[ColorLevel; LEVELS]>,
+    from_field: bool,
+}
+
+/// The scene's sprite clouds and their GPU records.
+pub struct CloudSet {
+    authored: Vec<Placed>,
+    tiling: Option<FieldTiling>,
+    tiles: BTreeMap<TileKey, Option<SpriteCloud>>,
+    scene_key: String,
+    sun: Vec3,
+    lod: SpriteLod,
+    /// The sprites, cloud by cloud.
+    pub sprites: Vec<GpuSprite>,
+    /// The clouds.
+    pub clouds: Vec<GpuCloud>,
+    /// Per cloud: its centre at time 0 (wind frame) and its layer.
+    pub cloud_centres: Vec<(Vec3, u32)>,
+    /// Bumped whenever `sprites` or `clouds` change.
+    pub generation: u64,
+}
+
+impl CloudSet {
+    /// The set of `scene` with the hand-made and model-file clouds `authored` (with their levels,
+    /// None to derive them).
+    pub fn new(authored: Vec<(SpriteCloud, Option<[ColorLevel; LEVELS]>)>) -> CloudSet {
+        CloudSet {
+            authored: authored
+                .into_iter()
+                .map(|(cloud, levels)| Placed {
+                    cloud,
+                    levels,
+                    from_field: false,
+                })
+                .collect(),
+            tiling: None,
+            tiles: BTreeMap::new(),
+            scene_key: String::new(),
+            sun: Vec3::ZERO,
+            lod: SpriteLod::Clusters,
+            sprites: Vec::new(),
+            clouds: Vec::new(),
+            cloud_centres: Vec::new(),
+            generation: 0,
+        }
+    }
+
+    /// Brings the set to this frame: makes the field clouds of tiles the camera reached, forgets
+    /// those it left, and relights the groups when the sun turned. Returns whether the records
+    /// changed.
+    pub fn update(
+        &mut self,
+        field: &CloudField,
+        scene: &Scene,
+        camera_m: Vec3,
+        sun: Vec3,
+        g: f32,
+    ) -> bool {
+        let key = scene_key(scene);
+        if key != self.scene_key {
+            self.scene_key = key;
+            self.tiles.clear();
+            self.sprites.clear();
+            self.lod = scene.sprites.lod;
+            self.tiling = scene.sprites.field_clouds.then_some(FieldTiling {
+                tile_m: scene.sprites.cloud_size_m,
+                distance_m: scene.sprites.distance_m,
+                time_s: 0.0,
+            });
+        }
+        let mut changed = self.sprites.is_empty() && self.clouds.is_empty();
+        if let Some(tiling) = self.tiling.as_mut() {
+            tiling.time_s = scene.render.time_s;
+            let wanted = tiling.tiles_around(field, camera_m);
+            let missing: Vec<TileKey> = wanted
+                .iter()
+                .filter(|k| !self.tiles.contains_key(k))
+                .copied()
+                .collect();
+            let keep: std::collections::BTreeSet<TileKey> = wanted.into_iter().collect();
+            let before = self.tiles.len();
+            self.tiles.retain(|k, _| keep.contains(k));
+            changed |= self.tiles.len() != before || !missing.is_empty();
+            let made = tiling.clouds(field, &missing);
+            let mut made: BTreeMap<TileKey, SpriteCloud> = made.into_iter().collect();
+            for k in missing {
+                self.tiles.insert(k, made.remove(&k));
+            }
+        }
+        let relight = self.sun.angle_between(sun) > SUN_TOLERANCE_RAD || self.sun == Vec3::ZERO;
+        if changed || relight {
+            self.sun = sun;
+            self.rebuild(field, scene, g);
+            self.generation += 1;
+            return true;
+        }
+        false
+    }
+
+    /// Lays every cloud out again.
+    fn rebuild(&mut self, field: &CloudField, scene: &Scene, g: f32) {
+        let field_clouds = self.tiles.values().flatten().map(|cloud| Placed {
+            cloud: cloud.clone(),
+            levels: None,
+            from_field: true,
+        });
+        let all: Vec<Placed> = self.authored.iter().cloned().chain(field_clouds).collect();
+        self.sprites.clear();
+        self.clouds.clear();
+        self.cloud_centres.clear();
+        let default_extinction = scene
+            .layers
+            .iter()
+            .map(|l| l.extinction_per_m)
+            .reduce(f32::max)
+            .unwrap_or(DEFAULT_EXTINCTION_PER_M);
+        let light = SunLight::from_scene(scene, self.sun, g);
+        let laid: Vec<(GpuCloud, Vec<GpuSprite>)> = {
+            use rayon::prelude::*;
+            all.par_iter()
+                .map(|p| {
+                    let extinction = p
+                        .cloud
+                        .layer
+                        .and_then(|l| field.layers.get(l as usize))
+                        .map_or(default_extinction, |l| l.extinction_per_m);
+                    self.lay_out(p, field, &light.with_extinction(extinction))
+                })
+                .collect()
+        };
+        for (index, (cloud, sprites)) in laid.into_iter().enumerate() {
+            let placed = &all[index];
+            self.cloud_centres.push((
+                placed.cloud.center_m,
+                placed.cloud.layer.unwrap_or(NO_LAYER),
+            ));
+            self.clouds.push(cloud);
+            self.sprites.extend(sprites.into_iter().map(|mut s| {
+                s.cloud = index as u32;
+                s
+            }));
+        }
+    }
+
+    /// One cloud's record and its sprites' (their `cloud` index set by the caller).
+    fn lay_out(
+        &self,
+        placed: &Placed,
+        field: &CloudField,
+        light: &SunLight,
+    ) -> (GpuCloud, Vec<GpuSprite>) {
+        let cloud = match self.lod {
+            SpriteLod::Clusters => placed.cloud.clone(),
+            SpriteLod::Billboards => placed.cloud.billboard(),
+        };
+        let (lo, hi) = placed.cloud.vertical_extent_m();
+        let height = (hi - lo).max(1.0);
+        let levels = placed
+            .levels
+            .unwrap_or_else(|| physical_levels(height, light.extinction_per_m, light.g));
+        let lights = shading::group_lights(&cloud, placed.from_field.then_some(field), light);
+        let layer = cloud.layer.unwrap_or(NO_LAYER);
+        let sprites = cloud
+            .sprites
+            .iter()
+            .map(|s| {
+                let light = lights[s.group as usize];
+                GpuSprite {
+                    position_m: cloud.center_m + s.offset_m,
+                    layer,
+                    size_m: s.size_m,
+                    rotation_rad: s.rotation_rad,
+                    texture: s.texture,
+                    cloud: 0,
+                    opacity: s.opacity,
+                    directional: light.directional,
+                    sun_transmittance: light.sun_transmittance,
+                }
+            })
+            .collect();
+        (
+            GpuCloud::new(&levels, cloud.center_m.y + lo, height),
+            sprites,
+        )
+    }
+
+    /// Every cloud drawn, as the model file would hold it (field clouds as made this frame).
+    pub fn sprite_clouds(&self) -> Vec<SpriteCloud> {
+        self.authored
+            .iter()
+            .map(|p| p.cloud.clone())
+            .chain(self.tiles.values().flatten().cloned())
+            .collect()
+    }
+}
+
+/// What the clouds depend on besides the camera, time and sun: a change rebuilds them all.
+fn scene_key(scene: &Scene) -> String {
+    format!(
+        "{:?}",
+        (
+            &scene.layers,
+            &scene.weather,
+            &scene.noise,
+            &scene.planet,
+            &scene.sprites,
+            &scene.sprite_clouds,
+            scene.phase.g,
+        )
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout_check::assert_wgsl_layout;
+
+    #[test]
+    fn sprite_records_match_their_wgsl_layout() {
+        assert_wgsl_layout!(
+            "sprite_render",
+            "Sprite",
+            GpuSprite {
+                position_m,
+                layer,
+                size_m,
+                rotation_rad,
+                texture,
+                cloud,
+                opacity,
+                directional,
+                sun_transmittance,
+            }
+        );
+        assert_wgsl_layout!(
+            "sprite_render",
+            "Cloud",
+            GpuCloud {
+                colors,
+                level_heights,
+                top_level_height,
+                bottom_y_m,
+                height_m,
+                pad,
+            }
+        );
+    }
+}

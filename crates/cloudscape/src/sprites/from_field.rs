@@ -1,0 +1,215 @@
+//! Sprite clouds from the cloud field, so the sprites show the clouds the ray marcher shows, in the
+//! same places.
+//!
+//! Each layer is cut into square tiles of `sprites.cloud_size_m` that move with the layer's wind
+//! (the field moves rigidly with it, so a tile's cloud keeps its shape). The cloudy part of a tile
+//! becomes one cloud:
+//!
+//! 1. Candidate centres fill the tile over the band where the tile's cloud type can have cloud
+//!    (its height profile), and Wang 2003's cull thins them to one per cull radius. None of this
+//!    depends on coverage, so a sequence whose coverage changes keeps every sprite in place.
+//! 2. Each candidate reads the coarse field (weather, height profile, base noise: the density the
+//!    ray marcher's light paths read) at its centre. Where it is clear, the sprite is dropped;
+//!    elsewhere its opacity ramps up with the density. As coverage grows, the densest cores pass
+//!    the threshold first and the edges last, so clouds form from the core and dissipate from the
+//!    edges (Wang 2003, "Animation"), as the field's clouds do.
+//! 3. The cloud's boxes are the columns of a 3 x 3 split of the tile, each from its lowest sprite
+//!    bottom to its highest top: a footprint, base and top that follow the field.
+
+use glam::{IVec2, Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::model::{SpriteBox, SpriteCloud, assign_groups, cull, dress, unit_random};
+use super::types::CloudType;
+use crate::field::noise::pcg_hash;
+use crate::field::{CloudField, LayerField, profile};
+use crate::particles::generate::world_point;
+
+/// Normalised coarse density (of the layer's densest) over which a sprite's opacity ramps from 0
+/// to full: its presence, `saturate(density / ramp)`.
+pub const PRESENCE_RAMP: f32 = 0.25;
+/// Sprites thinner than this presence are dropped.
+pub const MIN_PRESENCE: f32 = 0.02;
+/// A field cloud's nominal height, which its cull radius and sprite sizes are fractions of, as a
+/// fraction of the band its type can fill: cumulus rarely fill the whole band (tuned by eye
+/// against the ray marcher on the default scene).
+const NOMINAL_HEIGHT: f32 = 0.6;
+/// Candidates drawn per cull-radius cell of the band: enough that the cull, not the draw, sets the
+/// spacing.
+const CANDIDATES_PER_CELL: f32 = 2.0;
+/// Most candidates a tile draws.
+const MAX_CANDIDATES: u32 = 600;
+/// Columns along each side of a tile that the cloud's boxes follow.
+const BOX_COLUMNS: i32 = 3;
+/// Height fractions at which the band of a type's profile is searched.
+const BAND_STEPS: u32 = 32;
+
+/// Where and how far field clouds are made.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FieldTiling {
+    /// Side of a tile, m: the largest a field cloud gets.
+    pub tile_m: f32,
+    /// Tiles whose centre lies within this horizontal distance of the camera are made, m.
+    pub distance_m: f32,
+    /// Scene time, s (tiles move with the wind).
+    pub time_s: f32,
+}
+
+/// One tile of one layer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct TileKey {
+    /// Layer index.
+    pub layer: u32,
+    /// Tile lattice position in the layer's wind frame, (x, z).
+    pub tile: [i32; 2],
+}
+
+impl FieldTiling {
+    /// The tiles around `camera_m` in every layer, nearest layer first then row by row.
+    pub fn tiles_around(&self, field: &CloudField, camera_m: Vec3) -> Vec<TileKey> {
+        let mut keys = Vec::new();
+        for (index, layer) in field.layers.iter().enumerate() {
+            let eye = self.wind_frame(layer, Vec2::new(camera_m.x, camera_m.z));
+            let reach = (self.distance_m / self.tile_m).ceil() as i32 + 1;
+            let centre = (eye / self.tile_m).floor().as_ivec2();
+            for dz in -reach..=reach {
+                for dx in -reach..=reach {
+                    let tile = centre + IVec2::new(dx, dz);
+                    let mid = (tile.as_vec2() + 0.5) * self.tile_m;
+                    if mid.distance(eye) <= self.distance_m {
+                        keys.push(TileKey {
+                            layer: index as u32,
+                            tile: tile.to_array(),
+                        });
+                    }
+                }
+            }
+        }
+        keys
+    }
+
+    /// A world position `xz` at this time in the wind frame of `layer` (where it was at time 0).
+    pub fn wind_frame(&self, layer: &LayerField, xz: Vec2) -> Vec2 {
+        xz - layer.wind_m_per_s * self.time_s
+    }
+
+    /// The clouds of `keys`, in parallel; clear tiles give none.
+    pub fn clouds(&self, field: &CloudField, keys: &[TileKey]) -> Vec<(TileKey, SpriteCloud)> {
+        keys.par_iter()
+            .filter_map(|&key| Some((key, self.cloud(field, key)?)))
+            .collect()
+    }
+
+    /// The cloud of one tile, in the layer's wind frame (place it at scene time t by adding
+    /// `wind t`); None where the tile is clear.
+    pub fn cloud(&self, field: &CloudField, key: TileKey) -> Option<SpriteCloud> {
+        let layer = &field.layers[key.layer as usize];
+        let tile = IVec2::from_array(key.tile);
+        let origin = tile.as_vec2() * self.tile_m;
+        let middle = origin + 0.5 * self.tile_m;
+        let weather = field
+            .weather
+            .texture
+            .sample((middle / field.weather.extent_m + layer.weather_offset).extend(0.0));
+        let type_coord = layer.types.type_coord(weather.y);
+        let (bottom, top) = profile_band(layer, type_coord)?;
+        let height = NOMINAL_HEIGHT * (top - bottom).min(self.tile_m);
+        let cloud_type = CloudType::from_field(type_coord, bottom, height);
+        let recipe = cloud_type.recipe();
+        let seed = pcg_hash(
+            pcg_hash(layer.noise_offset_m.x.to_bits())
+                ^ pcg_hash(tile.x as u32 ^ pcg_hash(tile.y as u32)),
+        );
+        let radius = recipe.cull_fraction * height;
+        let cells = self.tile_m * self.tile_m * (top - bottom) / radius.powi(3);
+        let n = ((cells * CANDIDATES_PER_CELL) as u32).clamp(recipe.sprites, MAX_CANDIDATES);
+        let point = |k: u32| {
+            let u = |lane| unit_random(seed, k, lane);
+            let xz = origin + Vec2::new(u(0), u(1)) * self.tile_m;
+            (xz, bottom + u(2) * (top - bottom))
+        };
+        let candidates: Vec<Vec3> = (0..n)
+            .map(|k| {
+                let (xz, altitude) = point(k);
+                Vec3::new(xz.x, altitude, xz.y)
+            })
+            .collect();
+        let centre = world_point(field, middle, 0.5 * (bottom + top));
+        let sprites: Vec<_> = cull(&candidates, radius)
+            .iter()
+            .enumerate()
+            .filter_map(|(k, c)| {
+                let p = world_point(field, Vec2::new(c.x, c.z), c.y);
+                let density = field.coarse_extinction_per_m(p, 0.0) / layer.extinction_per_m;
+                let presence = (density / PRESENCE_RAMP).min(1.0);
+                (presence >= MIN_PRESENCE).then(|| {
+                    let mut s = dress(&recipe, seed, k as u32, p - centre, height);
+                    s.opacity *= presence;
+                    s
+                })
+            })
+            .collect();
+        if sprites.is_empty() {
+            return None;
+        }
+        let mut cloud = SpriteCloud {
+            cloud_type,
+            center_m: centre,
+            boxes: Vec::new(),
+            layer: Some(key.layer),
+            sprites,
+        };
+        cloud.boxes = column_boxes(&cloud, self.tile_m);
+        assign_groups(&mut cloud.sprites, recipe.group_size);
+        Some(cloud)
+    }
+}
+
+/// The altitudes where a layer's cloud of type coordinate `type_coord` can have density (its
+/// height gradient is positive), m; None if nowhere.
+pub fn profile_band(layer: &LayerField, type_coord: f32) -> Option<(f32, f32)> {
+    let inside: Vec<f32> = (0..=BAND_STEPS)
+        .map(|i| i as f32 / BAND_STEPS as f32)
+        .filter(|&f| profile::height_gradient(type_coord, f) > 0.0)
+        .collect();
+    let (lo, hi) = (*inside.first()?, *inside.last()?);
+    let step = 1.0 / BAND_STEPS as f32;
+    let at = |f: f32| layer.bottom_m + f.clamp(0.0, 1.0) * layer.thickness_m;
+    Some((at(lo - step), at(hi + step)))
+}
+
+/// The boxes of a field cloud: each of the tile's columns that holds sprites, from its lowest
+/// sprite bottom to its highest top (relative to the cloud's centre).
+fn column_boxes(cloud: &SpriteCloud, tile_m: f32) -> Vec<SpriteBox> {
+    let column_m = tile_m / BOX_COLUMNS as f32;
+    let mut boxes = Vec::new();
+    for cz in 0..BOX_COLUMNS {
+        for cx in 0..BOX_COLUMNS {
+            let lo = Vec2::new(cx as f32, cz as f32) * column_m - 0.5 * tile_m;
+            let inside = |s: &&super::model::Sprite| {
+                let d = Vec2::new(s.offset_m.x, s.offset_m.z) - lo;
+                d.cmpge(Vec2::ZERO).all() && d.cmplt(Vec2::splat(column_m)).all()
+            };
+            let (bottom, top) =
+                cloud
+                    .sprites
+                    .iter()
+                    .filter(inside)
+                    .fold((f32::MAX, f32::MIN), |(b, t), s| {
+                        let half = 0.5 * s.size_m.y;
+                        (b.min(s.offset_m.y - half), t.max(s.offset_m.y + half))
+                    });
+            if bottom < top {
+                boxes.push(SpriteBox {
+                    center_m: Vec3::new(
+                        lo.x + 0.5 * column_m,
+                        0.5 * (bottom + top),
+                        lo.y + 0.5 * column_m,
+                    ),
+                    size_m: Vec3::new(column_m, top - bottom, column_m),
+                });
+            }
+        }
+    }
+    boxes
+}

@@ -1,0 +1,863 @@
+//! The sprite technique (`render.technique = "sprites"`, Wang 2003): the scene's sprite clouds
+//! ([`super::cloud_set`]) drawn as textured quads, back to front with premultiplied alpha, into
+//! two blended targets that a resolve pass turns into the cloud-output contract; clouds beyond
+//! the impostor ring are drawn into the ring's 8 impostors ([`super::impostors`]) and the ring
+//! first, behind the rest.
+
+use std::path::Path;
+
+use bytemuck::{Pod, Zeroable};
+use glam::{UVec2, Vec2, Vec3, Vec4};
+
+use super::cloud_set::{CloudSet, GpuCloud, GpuSprite};
+use super::impostors::{ASPECT, SECTORS, SectorView};
+use super::shading::{ColorLevel, LEVELS};
+use super::textures::{SHEET_TEXELS, bake_sheet};
+use super::views::{Reach, SortedView, ViewUniform, sector_elevations, sort_view, wind_offsets_m};
+use super::{CloudModel, ModelFile};
+use crate::field::FieldError;
+use crate::frame::{Shared, SharedSlots};
+use crate::gpu::pipeline::{
+    BindGroupCache, PREMULTIPLIED_OVER, RasterDescriptor, UNFILTERABLE_TEXTURE_2D, UNIFORM,
+    bind_group, bind_group_layout, compute_pipeline, dispatch_2d, float_texture, render_pipeline,
+    storage_binding, storage_buffer, storage_texture_2d, uniform_buffer,
+};
+use crate::gpu::{GpuContext, PassTimer};
+use crate::optics::PhaseLobes;
+use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
+use crate::scene::{Scene, SpriteCloudSpec};
+use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
+
+/// The timed passes of a frame, in order (the impostor pass only in frames that render one).
+pub const PASS_NAMES: &[&str] = &["sprites: impostors", "sprites: draw", "sprites: resolve"];
+/// Format of both blended targets and of the impostors.
+const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The `Settings` uniform of `sprite_render.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct SettingsUniform {
+    wind_offset_m: [Vec4; 4],
+    ambient_override: Vec3,
+    ambient_overridden: u32,
+    directional_override: Vec3,
+    directional_overridden: u32,
+    phase_lobes: Vec4,
+    albedo: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
+}
+
+/// One sector of the `Ring` uniform of `sprite_impostor.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct GpuSector {
+    corners_m: [Vec4; 4],
+    ready: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+
+/// A view's uniform and sorted list on the GPU.
+struct ViewBuffers {
+    uniform: wgpu::Buffer,
+    order: wgpu::Buffer,
+    count: u32,
+}
+
+impl ViewBuffers {
+    fn new(ctx: &GpuContext, label: &str) -> ViewBuffers {
+        ViewBuffers {
+            uniform: uniform_buffer(ctx, label, size_of::<ViewUniform>() as u64),
+            order: storage_buffer(ctx, label, 4),
+            count: 0,
+        }
+    }
+
+    /// Uploads `view` and `sorted`, growing the list's buffer when needed; whether it grew.
+    fn write(&mut self, ctx: &GpuContext, view: &ViewUniform, sorted: &SortedView) -> bool {
+        ctx.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(view));
+        let bytes = (sorted.order.len().max(1) * 4) as u64;
+        let grew = bytes > self.order.size();
+        if grew {
+            self.order = storage_buffer(ctx, "sprite order", bytes.next_power_of_two());
+        }
+        if !sorted.order.is_empty() {
+            ctx.queue
+                .write_buffer(&self.order, 0, bytemuck::cast_slice(&sorted.order));
+        }
+        self.count = sorted.order.len() as u32;
+        grew
+    }
+}
+
+/// The two blended targets at the output's size.
+struct RasterTargets {
+    size: UVec2,
+    radiance: wgpu::TextureView,
+    distance: wgpu::TextureView,
+}
+
+impl RasterTargets {
+    fn textures(ctx: &GpuContext, size: UVec2, layers: u32) -> (wgpu::Texture, wgpu::Texture) {
+        let make = |label| {
+            ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: size.x,
+                    height: size.y,
+                    depth_or_array_layers: layers,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: TARGET_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+        };
+        (make("sprite radiance"), make("sprite distance"))
+    }
+
+    fn single(ctx: &GpuContext, size: UVec2) -> RasterTargets {
+        let (r, d) = RasterTargets::textures(ctx, size, 1);
+        RasterTargets {
+            size,
+            radiance: r.create_view(&Default::default()),
+            distance: d.create_view(&Default::default()),
+        }
+    }
+}
+
+/// The ring's impostors: 8 layers of the two targets, each sector's view, and the ring uniform.
+struct Ring {
+    texels: UVec2,
+    layers: Vec<(wgpu::TextureView, wgpu::TextureView)>,
+    radiance_array: wgpu::TextureView,
+    distance_array: wgpu::TextureView,
+    sectors: [Option<SectorView>; SECTORS],
+    views: Vec<ViewBuffers>,
+    uniform: wgpu::Buffer,
+    group: Option<(wgpu::TextureView, wgpu::BindGroup)>,
+    sector_groups: Vec<Option<wgpu::BindGroup>>,
+    /// Sectors to render this frame.
+    pending: Vec<usize>,
+}
+
+impl Ring {
+    fn new(ctx: &GpuContext, texels: u32) -> Ring {
+        let size = UVec2::new(texels, (texels as f32 * ASPECT) as u32);
+        let (r, d) = RasterTargets::textures(ctx, size, SECTORS as u32);
+        let layer = |t: &wgpu::Texture, k: u32| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: k,
+                array_layer_count: Some(1),
+                ..Default::default()
+            })
+        };
+        let array = |t: &wgpu::Texture| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        };
+        Ring {
+            texels: size,
+            layers: (0..SECTORS as u32)
+                .map(|k| (layer(&r, k), layer(&d, k)))
+                .collect(),
+            radiance_array: array(&r),
+            distance_array: array(&d),
+            sectors: [None; SECTORS],
+            views: (0..SECTORS)
+                .map(|_| ViewBuffers::new(ctx, "impostor view"))
+                .collect(),
+            uniform: uniform_buffer(
+                ctx,
+                "impostor ring",
+                (SECTORS * size_of::<GpuSector>()) as u64,
+            ),
+            group: None,
+            sector_groups: vec![None; SECTORS],
+            pending: Vec::new(),
+        }
+    }
+
+    /// Forgets the bind groups (a buffer they bind was replaced).
+    fn forget_groups(&mut self) {
+        self.group = None;
+        self.sector_groups.iter_mut().for_each(|g| *g = None);
+    }
+
+    fn uniform(&self) -> [GpuSector; SECTORS] {
+        std::array::from_fn(|k| match &self.sectors[k] {
+            Some(s) => GpuSector {
+                corners_m: s.corners_m.map(|c| c.extend(1.0)),
+                ready: 1,
+                ..GpuSector::zeroed()
+            },
+            None => GpuSector::zeroed(),
+        })
+    }
+}
+
+/// What the sprite technique counted in a frame (on the CPU, so current).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SpriteStats {
+    /// Clouds in the set.
+    pub clouds: u32,
+    /// Sprites in the set.
+    pub sprites: u32,
+    /// Sprites drawn in 3D this frame.
+    pub drawn: u32,
+    /// Impostors rendered this frame.
+    pub impostors_rendered: u32,
+    /// Layers of sprites per output texel drawn in 3D (their projected areas over the view's).
+    pub overdraw: f64,
+}
+
+/// The sprite technique.
+pub struct SpriteRenderer {
+    slots: [SharedSlots; 3],
+    sprite_layout: wgpu::BindGroupLayout,
+    impostor_layout: wgpu::BindGroupLayout,
+    resolve_layout: wgpu::BindGroupLayout,
+    sprite_pipeline: wgpu::RenderPipeline,
+    impostor_pipeline: wgpu::RenderPipeline,
+    resolve_pipeline: wgpu::ComputePipeline,
+    settings: wgpu::Buffer,
+    resolve: wgpu::Buffer,
+    sheet: wgpu::TextureView,
+    sampler: wgpu::Sampler,
+    set: CloudSet,
+    uploaded: Option<(u64, wgpu::Buffer, wgpu::Buffer)>,
+    main: ViewBuffers,
+    ring: Option<Ring>,
+    ring_radius_m: f32,
+    targets: Option<RasterTargets>,
+    main_group: Option<(wgpu::TextureView, wgpu::BindGroup)>,
+    no_depth: wgpu::TextureView,
+    resolve_groups: BindGroupCache,
+    stats: SpriteStats,
+    pixels: u32,
+}
+
+impl SpriteRenderer {
+    /// Builds the passes against the shared groups' layouts, bakes the puff sheet, and builds the
+    /// scene's hand-made clouds and those of its model file (`sprites.model`, relative to
+    /// `base_dir`; an unreadable or invalid file is a located error).
+    pub fn new(
+        ctx: &GpuContext,
+        shared: &Shared,
+        scene: &Scene,
+        base_dir: &Path,
+    ) -> Result<SpriteRenderer, FieldError> {
+        let authored = authored_clouds(scene, base_dir)?;
+        let filterable = float_texture(wgpu::TextureViewDimension::D2);
+        let sampler_type = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
+        let read_only = storage_binding(true);
+        let device = &ctx.device;
+        let sprite_layout = bind_group_layout(
+            device,
+            "sprites",
+            &[
+                UNIFORM,
+                UNIFORM,
+                read_only,
+                read_only,
+                read_only,
+                filterable,
+                sampler_type,
+                UNFILTERABLE_TEXTURE_2D,
+            ],
+        );
+        let array = float_texture(wgpu::TextureViewDimension::D2Array);
+        let impostor_layout = bind_group_layout(
+            device,
+            "sprite impostors",
+            &[
+                UNIFORM,
+                UNIFORM,
+                array,
+                array,
+                sampler_type,
+                UNFILTERABLE_TEXTURE_2D,
+            ],
+        );
+        let resolve_layout = bind_group_layout(
+            device,
+            "sprite resolve",
+            &[
+                UNIFORM,
+                UNFILTERABLE_TEXTURE_2D,
+                UNFILTERABLE_TEXTURE_2D,
+                storage_texture_2d(CLOUD_FORMAT),
+                storage_texture_2d(CLOUD_DISTANCE_FORMAT),
+            ],
+        );
+        let slots = ["sprite_render", "sprite_impostor", "sprite_resolve"].map(SharedSlots::of);
+        let blended = Some(wgpu::ColorTargetState {
+            format: TARGET_FORMAT,
+            blend: Some(PREMULTIPLIED_OVER),
+            write_mask: wgpu::ColorWrites::ALL,
+        });
+        let raster = |program: &str, entries, layout| {
+            let source = crate::shader::program(program);
+            render_pipeline(
+                ctx,
+                &RasterDescriptor {
+                    label: program,
+                    source: &source,
+                    entries,
+                    targets: &[blended.clone(), blended.clone()],
+                    depth: None,
+                    topology: wgpu::PrimitiveTopology::TriangleStrip,
+                },
+                &shared.layouts(SharedSlots::of(program), layout),
+            )
+        };
+        let sprite_pipeline = raster("sprite_render", ("vs_sprite", "fs_sprite"), &sprite_layout);
+        let impostor_pipeline = raster(
+            "sprite_impostor",
+            ("vs_impostor", "fs_impostor"),
+            &impostor_layout,
+        );
+        let resolve_pipeline = compute_pipeline(
+            ctx,
+            "sprite resolve",
+            &crate::shader::program("sprite_resolve"),
+            "resolve_sprites",
+            &shared.layouts(slots[2], &resolve_layout),
+        );
+        Ok(SpriteRenderer {
+            slots,
+            sprite_layout,
+            impostor_layout,
+            resolve_layout,
+            sprite_pipeline,
+            impostor_pipeline,
+            resolve_pipeline,
+            settings: uniform_buffer(ctx, "sprite settings", size_of::<SettingsUniform>() as u64),
+            resolve: uniform_buffer(ctx, "sprite resolve", 16),
+            sheet: upload_sheet(ctx),
+            sampler: ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("sprites"),
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                ..Default::default()
+            }),
+            set: CloudSet::new(authored),
+            uploaded: None,
+            main: ViewBuffers::new(ctx, "sprite view"),
+            ring: None,
+            ring_radius_m: 0.0,
+            targets: None,
+            main_group: None,
+            no_depth: crate::gpu::pipeline::texture_2d(
+                ctx,
+                "no host depth",
+                UVec2::ONE,
+                wgpu::TextureFormat::R32Float,
+                wgpu::TextureUsages::TEXTURE_BINDING,
+            )
+            .create_view(&Default::default()),
+            resolve_groups: BindGroupCache::default(),
+            stats: SpriteStats::default(),
+            pixels: 0,
+        })
+    }
+
+    /// The counts of the newest frame.
+    pub fn sprite_stats(&self) -> SpriteStats {
+        self.stats
+    }
+
+    /// The clouds drawn in the newest frame, as a model file would hold them.
+    pub fn clouds(&self) -> Vec<super::SpriteCloud> {
+        self.set.sprite_clouds()
+    }
+
+    /// Uploads the set's records when they changed.
+    fn upload_set(&mut self, ctx: &GpuContext) {
+        if self
+            .uploaded
+            .as_ref()
+            .is_some_and(|u| u.0 == self.set.generation)
+        {
+            return;
+        }
+        let sprites: &[GpuSprite] = if self.set.sprites.is_empty() {
+            &[GpuSprite::zeroed()]
+        } else {
+            &self.set.sprites
+        };
+        let clouds: &[GpuCloud] = if self.set.clouds.is_empty() {
+            &[GpuCloud::zeroed()]
+        } else {
+            &self.set.clouds
+        };
+        let buffer = |label, bytes: &[u8]| {
+            let b = storage_buffer(ctx, label, bytes.len() as u64);
+            ctx.queue.write_buffer(&b, 0, bytes);
+            b
+        };
+        self.uploaded = Some((
+            self.set.generation,
+            buffer("sprites", bytemuck::cast_slice(sprites)),
+            buffer("sprite clouds", bytemuck::cast_slice(clouds)),
+        ));
+        self.main_group = None;
+        if let Some(ring) = self.ring.as_mut() {
+            ring.forget_groups();
+        }
+    }
+
+    /// Decides which sectors to render this frame and sorts their lists.
+    fn prepare_ring(
+        &mut self,
+        ctx: &GpuContext,
+        scene: &Scene,
+        eye: Vec3,
+        time_s: f32,
+        offsets: &[Vec4; 4],
+    ) {
+        let radius = scene.sprites.ring_radius_m;
+        let texels = scene.sprites.impostor_texels;
+        if radius <= 0.0 {
+            self.ring = None;
+            return;
+        }
+        if self
+            .ring
+            .as_ref()
+            .is_none_or(|r| r.texels.x != texels || self.ring_radius_m != radius)
+        {
+            self.ring = Some(Ring::new(ctx, texels));
+            self.ring_radius_m = radius;
+        }
+        let set = &self.set;
+        let ring = self.ring.as_mut().expect("made above");
+        let stale: Vec<usize> = (0..SECTORS)
+            .filter(|&k| ring.sectors[k].is_none_or(|s| s.stale(eye, time_s, radius)))
+            .collect();
+        // All at once when none is ready (the first frame, a still); else one per frame, the
+        // oldest first, so the work spreads over frames.
+        ring.pending = if ring.sectors.iter().all(Option::is_none) {
+            stale
+        } else {
+            stale
+                .into_iter()
+                .min_by(|&a, &b| {
+                    let age = |k: usize| ring.sectors[k].map_or(f32::MIN, |s| s.time_s);
+                    age(a).total_cmp(&age(b))
+                })
+                .into_iter()
+                .collect()
+        };
+        for &k in &ring.pending {
+            let tans = sector_elevations(set, offsets, eye, k, radius);
+            let sector = SectorView::new(k, eye, time_s, radius, tans);
+            let sorted = sort_view(
+                set,
+                offsets,
+                (eye, sector.forward),
+                Reach::Beyond(radius),
+                Vec2::ONE,
+            );
+            if ring.views[k].write(ctx, &ViewUniform::of_sector(&sector, scene), &sorted) {
+                ring.sector_groups[k] = None;
+            }
+            ring.sectors[k] = Some(sector);
+        }
+        ctx.queue
+            .write_buffer(&ring.uniform, 0, bytemuck::cast_slice(&ring.uniform()));
+    }
+
+    /// The bind group of the sprite pass for `view` (host depth `depth`).
+    fn sprite_group(
+        &self,
+        ctx: &GpuContext,
+        view: &ViewBuffers,
+        depth: &wgpu::TextureView,
+    ) -> wgpu::BindGroup {
+        let (_, sprites, clouds) = self.uploaded.as_ref().expect("uploaded in prepare");
+        bind_group(
+            &ctx.device,
+            &self.sprite_layout,
+            &[
+                view.uniform.as_entire_binding(),
+                self.settings.as_entire_binding(),
+                sprites.as_entire_binding(),
+                clouds.as_entire_binding(),
+                view.order.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&self.sheet),
+                wgpu::BindingResource::Sampler(&self.sampler),
+                wgpu::BindingResource::TextureView(depth),
+            ],
+        )
+    }
+
+    /// Records the render of this frame's pending impostors.
+    fn encode_impostors(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        shared: &Shared,
+        timer: &mut Option<&mut PassTimer>,
+    ) {
+        let Some(mut ring) = self.ring.take() else {
+            return;
+        };
+        for &k in &ring.pending {
+            if ring.sector_groups[k].is_none() {
+                ring.sector_groups[k] =
+                    Some(self.sprite_group(ctx, &ring.views[k], &self.no_depth));
+            }
+        }
+        for (n, &k) in ring.pending.iter().enumerate() {
+            let group = ring.sector_groups[k].as_ref().expect("made above");
+            let writes = if n == 0 {
+                timer
+                    .as_deref_mut()
+                    .and_then(|t| t.render_pass_writes(PASS_NAMES[0]))
+            } else {
+                None
+            };
+            let (radiance, distance) = &ring.layers[k];
+            let mut pass = begin_targets(encoder, "sprite impostor", (radiance, distance), writes);
+            draw_sprites(
+                &mut pass,
+                &self.sprite_pipeline,
+                &shared.bind_groups(self.slots[0], group),
+                ring.views[k].count,
+            );
+        }
+        self.stats.impostors_rendered = ring.pending.len() as u32;
+        ring.pending.clear();
+        self.ring = Some(ring);
+    }
+}
+
+/// A hand-made or model-file cloud with its colour levels (None: derived).
+type Authored = (super::SpriteCloud, Option<[ColorLevel; LEVELS]>);
+
+/// The hand-made clouds of `scene` and those of its model file.
+fn authored_clouds(
+    scene: &Scene,
+    base_dir: &Path,
+) -> Result<Vec<Authored>, FieldError> {
+    let mut clouds: Vec<_> = scene
+        .sprite_clouds
+        .iter()
+        .map(|spec| (CloudModel::from_spec(spec).generate(None), levels_of(spec)))
+        .collect();
+    if let Some(path) = &scene.sprites.model {
+        let file = ModelFile::read(&base_dir.join(path)).map_err(|e| FieldError {
+            key_path: "sprites.model".into(),
+            message: e.to_string(),
+        })?;
+        clouds.extend(file.clouds().into_iter().map(|c| (c, None)));
+    }
+    Ok(clouds)
+}
+
+/// A hand-made cloud's colour levels, when the scene gives them.
+fn levels_of(spec: &SpriteCloudSpec) -> Option<[ColorLevel; LEVELS]> {
+    let given = spec.color_levels.as_ref()?;
+    Some(std::array::from_fn(|i| {
+        let [height, r, g, b, a] = given[i];
+        ColorLevel {
+            height,
+            rgba: Vec4::new(r, g, b, a),
+        }
+    }))
+}
+
+/// Uploads the baked puff sheet.
+fn upload_sheet(ctx: &GpuContext) -> wgpu::TextureView {
+    let size = UVec2::splat(SHEET_TEXELS);
+    let texture = crate::gpu::pipeline::texture_2d(
+        ctx,
+        "puff sheet",
+        size,
+        wgpu::TextureFormat::R8Unorm,
+        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+    );
+    ctx.queue.write_texture(
+        texture.as_image_copy(),
+        &bake_sheet(),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(SHEET_TEXELS),
+            rows_per_image: None,
+        },
+        wgpu::Extent3d {
+            width: size.x,
+            height: size.y,
+            depth_or_array_layers: 1,
+        },
+    );
+    texture.create_view(&Default::default())
+}
+
+/// A render pass into the two blended targets, cleared to nothing (no light, full transmittance).
+fn begin_targets<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    (radiance, distance): (&wgpu::TextureView, &wgpu::TextureView),
+    timestamps: Option<wgpu::RenderPassTimestampWrites>,
+) -> wgpu::RenderPass<'e> {
+    let attachment = |view| {
+        Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                store: wgpu::StoreOp::Store,
+            },
+        })
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[attachment(radiance), attachment(distance)],
+        depth_stencil_attachment: None,
+        timestamp_writes: timestamps,
+        ..Default::default()
+    })
+}
+
+/// Draws `count` sprites of the bound list (4 vertices each, a triangle strip).
+fn draw_sprites(
+    pass: &mut wgpu::RenderPass,
+    pipeline: &wgpu::RenderPipeline,
+    groups: &[Option<&wgpu::BindGroup>],
+    count: u32,
+) {
+    pass.set_pipeline(pipeline);
+    for (slot, group) in groups.iter().enumerate() {
+        if let Some(group) = group {
+            pass.set_bind_group(slot as u32, *group, &[]);
+        }
+    }
+    if count > 0 {
+        pass.draw(0..4, 0..count);
+    }
+}
+
+impl Technique for SpriteRenderer {
+    fn name(&self) -> &'static str {
+        "sprites"
+    }
+
+    fn pass_names(&self) -> &'static [&'static str] {
+        PASS_NAMES
+    }
+
+    fn prepare(&mut self, ctx: &GpuContext, inputs: &FrameInputs) {
+        let (scene, frame) = (inputs.scene, inputs.frame);
+        let eye = frame.camera_position_m;
+        let sun = crate::environment::Environment::from_scene(scene)
+            .sun
+            .direction;
+        self.set
+            .update(inputs.field, scene, eye, sun, frame.cloud_mean_cosine);
+        self.upload_set(ctx);
+        let offsets = wind_offsets_m(scene, frame.time_s);
+        let settings = SettingsUniform {
+            wind_offset_m: offsets,
+            ambient_override: Vec3::from_array(scene.sprites.ambient_color.unwrap_or_default()),
+            ambient_overridden: scene.sprites.ambient_color.is_some() as u32,
+            directional_override: Vec3::from_array(
+                scene.sprites.directional_color.unwrap_or_default(),
+            ),
+            directional_overridden: scene.sprites.directional_color.is_some() as u32,
+            phase_lobes: Vec4::from_array(PhaseLobes::from_scene(&scene.phase).to_gpu()),
+            albedo: scene.lighting.albedo,
+            ..SettingsUniform::zeroed()
+        };
+        ctx.queue
+            .write_buffer(&self.settings, 0, bytemuck::bytes_of(&settings));
+        let view = ViewUniform::of_frame(frame, inputs.grid, scene);
+        let forward = -frame
+            .view_from_world
+            .inverse()
+            .z_axis
+            .truncate()
+            .normalize();
+        let reach = match scene.sprites.ring_radius_m {
+            r if r > 0.0 => Reach::Within(r),
+            _ => Reach::All,
+        };
+        let focal = Vec2::new(frame.clip_from_view.x_axis.x, frame.clip_from_view.y_axis.y).abs();
+        let sorted = sort_view(&self.set, &offsets, (eye, forward), reach, focal);
+        if self.main.write(ctx, &view, &sorted) {
+            self.main_group = None;
+        }
+        self.prepare_ring(ctx, scene, eye, frame.time_s, &offsets);
+        self.stats = SpriteStats {
+            clouds: self.set.clouds.len() as u32,
+            sprites: self.set.sprites.len() as u32,
+            drawn: sorted.order.len() as u32,
+            impostors_rendered: 0,
+            overdraw: sorted.overdraw,
+        };
+    }
+
+    fn encode(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        shared: &Shared,
+        targets: &TechniqueTargets,
+        (origin, size): (UVec2, UVec2),
+        timer: Option<(&mut PassTimer, &str)>,
+    ) {
+        let mut timer = timer.map(|(t, _)| t);
+        self.encode_impostors(ctx, encoder, shared, &mut timer);
+        let output = targets.output;
+        if self.targets.as_ref().is_none_or(|t| t.size != output.size) {
+            self.targets = Some(RasterTargets::single(ctx, output.size));
+            self.resolve_groups.clear();
+        }
+        if self
+            .main_group
+            .as_ref()
+            .is_none_or(|(view, _)| view != targets.host_depth)
+        {
+            let group = self.sprite_group(ctx, &self.main, targets.host_depth);
+            self.main_group = Some((targets.host_depth.clone(), group));
+        }
+        let raster = self.targets.as_ref().expect("made above");
+        let group = &self.main_group.as_ref().expect("made above").1;
+        {
+            let writes = timer
+                .as_deref_mut()
+                .and_then(|t| t.render_pass_writes(PASS_NAMES[1]));
+            let mut pass = begin_targets(
+                encoder,
+                "sprites",
+                (&raster.radiance, &raster.distance),
+                writes,
+            );
+            pass.set_scissor_rect(origin.x, origin.y, size.x, size.y);
+            if let Some(ring) = self.ring.as_mut() {
+                if ring
+                    .group
+                    .as_ref()
+                    .is_none_or(|(view, _)| view != targets.host_depth)
+                {
+                    ring.group = None;
+                }
+                let (_, ring_group) = ring.group.get_or_insert_with(|| {
+                    (
+                        targets.host_depth.clone(),
+                        bind_group(
+                            &ctx.device,
+                            &self.impostor_layout,
+                            &[
+                                self.main.uniform.as_entire_binding(),
+                                ring.uniform.as_entire_binding(),
+                                wgpu::BindingResource::TextureView(&ring.radiance_array),
+                                wgpu::BindingResource::TextureView(&ring.distance_array),
+                                wgpu::BindingResource::Sampler(&self.sampler),
+                                wgpu::BindingResource::TextureView(targets.host_depth),
+                            ],
+                        ),
+                    )
+                });
+                draw_sprites(
+                    &mut pass,
+                    &self.impostor_pipeline,
+                    &shared.bind_groups(self.slots[1], ring_group),
+                    SECTORS as u32,
+                );
+            }
+            draw_sprites(
+                &mut pass,
+                &self.sprite_pipeline,
+                &shared.bind_groups(self.slots[0], group),
+                self.main.count,
+            );
+        }
+        ctx.queue
+            .write_buffer(&self.resolve, 0, bytemuck::cast_slice(&[origin, size]));
+        let resolve_group = self
+            .resolve_groups
+            .get(&[&output.radiance, &output.distance], || {
+                bind_group(
+                    &ctx.device,
+                    &self.resolve_layout,
+                    &[
+                        self.resolve.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(&raster.radiance),
+                        wgpu::BindingResource::TextureView(&raster.distance),
+                        wgpu::BindingResource::TextureView(&output.radiance),
+                        wgpu::BindingResource::TextureView(&output.distance),
+                    ],
+                )
+            });
+        let writes = timer.and_then(|t| t.compute_pass_writes(PASS_NAMES[2]));
+        dispatch_2d(
+            encoder,
+            "sprite resolve",
+            &self.resolve_pipeline,
+            &shared.bind_groups(self.slots[2], resolve_group),
+            size,
+            writes,
+        );
+        self.pixels = output.size.x * output.size.y;
+    }
+
+    fn finish_frame(&mut self, _encoder: &mut wgpu::CommandEncoder) {}
+
+    fn stats(&mut self, _ctx: &GpuContext) -> Option<TechniqueStats> {
+        Some(TechniqueStats {
+            pixels: self.pixels,
+            density_samples_per_pixel: self.stats.overdraw,
+            primitives: Some(self.stats.drawn + self.ring.as_ref().map_or(0, |_| SECTORS as u32)),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout_check::assert_wgsl_layout;
+
+    #[test]
+    fn uniforms_match_their_wgsl_layout() {
+        assert_wgsl_layout!(
+            "sprite_render",
+            "Settings",
+            SettingsUniform {
+                wind_offset_m,
+                ambient_override,
+                ambient_overridden,
+                directional_override,
+                directional_overridden,
+                phase_lobes,
+                albedo,
+                pad0,
+                pad1,
+                pad2,
+            }
+        );
+        assert_wgsl_layout!(
+            "sprite_impostor",
+            "Sector",
+            GpuSector {
+                corners_m,
+                ready,
+                pad0,
+                pad1,
+                pad2,
+            }
+        );
+    }
+}

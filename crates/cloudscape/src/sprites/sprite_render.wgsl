@@ -1,0 +1,165 @@
+#import constants frame environment phase sprite
+// The sprite pass (sprites/render.rs): every sprite of the view's sorted list, back to front, as
+// a textured quad blended over the ones behind it. Shading follows Wang 2003 with physically
+// derived numbers (sprites/shading.rs, the CPU specification); the in-cloud lock, fades and
+// formation are per vertex.
+
+// One sprite (sprites::render::GpuSprite).
+struct Sprite {
+    position_m: vec3<f32>,      // centre at time 0, in its layer's wind frame, m
+    layer: u32,                 // the layer whose wind carries it; 4 or more: none
+    size_m: vec2<f32>,          // width, height
+    rotation_rad: f32,          // about the view axis
+    texture: u32,               // tile of the puff sheet, 0..15
+    cloud: u32,                 // index into `clouds`
+    opacity: f32,               // type opacity times presence (formation)
+    directional: f32,           // its shading group's directional factor, 0..1
+    sun_transmittance: f32,     // direct sun reaching its group, 0..1 (silver lining)
+}
+
+// One cloud's colour levels (sprites::render::GpuCloud).
+struct Cloud {
+    colors: array<vec4<f32>, 5>, // ambient fraction (rgb) and opacity (a) of each level
+    level_heights: vec4<f32>,    // height fractions of levels 0..3
+    top_level_height: f32,       // height fraction of level 4
+    bottom_y_m: f32,             // world y of the cloud's bottom
+    height_m: f32,               // bottom to top
+    pad: f32,
+}
+
+// Settings every view shares (sprites::render::SpriteSettings).
+struct Settings {
+    wind_offset_m: array<vec4<f32>, 4>, // xy: each layer's drift (east, south) at this time, m
+    ambient_override: vec3<f32>,        // replaces the maximum ambient colour when set
+    ambient_overridden: u32,
+    directional_override: vec3<f32>,    // replaces the maximum directional colour when set
+    directional_overridden: u32,
+    phase_lobes: vec4<f32>,             // the scene's phase function (phase.wgsl)
+    albedo: f32,                        // single-scattering albedo
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
+}
+
+@group(3) @binding(0) var<uniform> view: View;
+@group(3) @binding(1) var<uniform> settings: Settings;
+@group(3) @binding(2) var<storage, read> sprites: array<Sprite>;
+@group(3) @binding(3) var<storage, read> clouds: array<Cloud>;
+@group(3) @binding(4) var<storage, read> order: array<u32>;
+@group(3) @binding(5) var puffs: texture_2d<f32>;
+@group(3) @binding(6) var puff_sampler: sampler;
+@group(3) @binding(7) var host_depth: texture_2d<f32>;
+
+struct Varying {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,                 // on the puff sheet
+    @location(1) diffuse: vec3<f32>,            // ambient + directional radiance
+    @location(2) single: vec3<f32>,             // single-scattered sun (silver lining)
+    @location(3) opacity: f32,
+    @location(4) distance_m: f32,
+    @location(5) soft_m: f32,
+}
+
+// Sheet layout (sprites/textures.rs).
+const SHEET_TILES: f32 = 4.0;
+
+// The colour at height fraction h: shading::level_at.
+fn sprite_level(c: Cloud, h: f32) -> vec4<f32> {
+    let heights = array<f32, 5>(c.level_heights.x, c.level_heights.y, c.level_heights.z, c.level_heights.w, c.top_level_height);
+    if h <= heights[0] {
+        return c.colors[0];
+    }
+    for (var i = 1u; i < 5u; i++) {
+        if h <= heights[i] {
+            let t = (h - heights[i - 1u]) / max(heights[i] - heights[i - 1u], 1e-6);
+            return mix(c.colors[i - 1u], c.colors[i], t);
+        }
+    }
+    return c.colors[4];
+}
+
+// Where the sprite's centre is now: its wind frame moved by its layer's drift.
+fn sprite_centre(s: Sprite) -> vec3<f32> {
+    if s.layer >= 4u {
+        return s.position_m;
+    }
+    let drift = settings.wind_offset_m[s.layer].xy;
+    return s.position_m + vec3<f32>(drift.x, 0.0, drift.y);
+}
+
+// Wang 2003's maximum ambient and directional colours, or the scene's overrides: the sky's mean
+// radiance from above and the sun's irradiance over pi, times the albedo (shading.rs).
+fn sprite_max_colours(p: vec3<f32>) -> array<vec3<f32>, 2> {
+    var ambient = settings.albedo * environment_sky_mean_radiance_up(p);
+    var directional = settings.albedo * environment_sun_irradiance(p) / PI;
+    if settings.ambient_overridden == 1u {
+        ambient = settings.ambient_override;
+    }
+    if settings.directional_overridden == 1u {
+        directional = settings.directional_override;
+    }
+    return array<vec3<f32>, 2>(ambient, directional);
+}
+
+@vertex
+fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> Varying {
+    let s = sprites[order[i]];
+    let centre = sprite_centre(s);
+    let to_eye = view.eye_m - centre;
+    let d = max(length(to_eye), 1e-3);
+    // Far sprites face the eye; within the lock distance they turn to face along the view (Wang's
+    // lock), blending over one more lock distance so nothing pops.
+    let lock = 1.0 - smoothstep(view.lock_distance_m, 2.0 * view.lock_distance_m, d);
+    let normal = normalize(mix(to_eye / d, -view.forward, lock) + vec3<f32>(0.0, 1e-5, 0.0));
+    var up_hint = vec3<f32>(0.0, 1.0, 0.0);
+    if abs(normal.y) > 0.99 {
+        up_hint = vec3<f32>(0.0, 0.0, -1.0);
+    }
+    let right = normalize(cross(up_hint, normal));
+    let up = cross(normal, right);
+    let corner = vec2<f32>(f32(v & 1u), f32(v >> 1u)) * 2.0 - 1.0;
+    let turn = vec2<f32>(cos(s.rotation_rad), sin(s.rotation_rad));
+    let turned = vec2<f32>(corner.x * turn.x - corner.y * turn.y, corner.x * turn.y + corner.y * turn.x);
+    let p = centre + (right * turned.x * s.size_m.x + up * turned.y * s.size_m.y) * 0.5;
+
+    // Fades: the sprite vanishes as the eye passes through it (Wang 2003; FlightGear fades sprites
+    // between 100 m and 10 m); a locked sprite seen edge-on turns transparent (Wang: the dot
+    // product of the lock angle and the angle to the camera); distant clouds fade out.
+    let radius = 0.5 * max(s.size_m.x, s.size_m.y);
+    let through = smoothstep(0.1 * radius, 0.6 * radius, d);
+    let edge_on = mix(1.0, abs(dot(normal, to_eye / d)), lock);
+    let horizontal = length(to_eye.xz);
+    let far = 1.0 - smoothstep(view.fade_start_m, view.fade_end_m, horizontal);
+
+    let c = clouds[s.cloud];
+    let level = sprite_level(c, clamp((p.y - c.bottom_y_m) / max(c.height_m, 1.0), 0.0, 1.0));
+    let maxima = sprite_max_colours(p);
+    let view_dir = normalize(p - view.eye_m);
+    let phase = phase_eval(settings.phase_lobes, dot(view_dir, environment_sun_direction()));
+
+    var out: Varying;
+    out.clip = sprite_clip(view, p);
+    let tile = vec2<f32>(f32(s.texture % 4u), f32(s.texture / 4u));
+    out.uv = (tile + corner * vec2<f32>(0.5, -0.5) + 0.5) / SHEET_TILES;
+    out.diffuse = level.rgb * maxima[0] + s.directional * maxima[1];
+    out.single = settings.albedo * environment_sun_irradiance(p) * s.sun_transmittance * phase;
+    out.opacity = s.opacity * level.a * through * edge_on * far;
+    out.distance_m = length(p - view.eye_m);
+    out.soft_m = 0.25 * radius;
+    return out;
+}
+
+@fragment
+fn fs_sprite(in: Varying) -> SpriteTargets {
+    let cover = textureSample(puffs, puff_sampler, in.uv).r;
+    var alpha = cover * in.opacity;
+    if view.host_depth_test == 1u {
+        let texel = in.clip.xy;
+        let depth = textureLoad(host_depth, vec2<i32>(sprite_frame_pixel(texel)), 0).x;
+        alpha *= sprite_host_fade(depth, texel, in.distance_m, in.soft_m);
+    }
+    // Thin parts of a puff scatter the direct sun once toward the eye; its thick core's light is
+    // the diffuse term's.
+    let radiance = alpha * (in.diffuse + (1.0 - cover) * in.single);
+    return sprite_targets(radiance, alpha, in.distance_m);
+}
