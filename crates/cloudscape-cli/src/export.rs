@@ -1,10 +1,13 @@
-//! `cloudscape export`: the cloud field over a box as a Mitsuba 3 `.vol` grid and scene.
+//! `cloudscape export`: the cloud field over a box as a Mitsuba 3 `.vol` grid and scene, or
+//! (`--sprites`) the scene's sprite clouds as a sprite model file.
 
 use crate::common::{SceneArgs, Stages};
 use anyhow::{Result, anyhow};
 use clap::Args;
 use cloudscape::export::write_mitsuba_scene;
 use cloudscape::field::{CloudField, VoxelGrid};
+use cloudscape::sprites::ModelFile;
+use cloudscape::sprites::cloud_set::scene_clouds;
 use glam::Vec3;
 use std::path::PathBuf;
 
@@ -14,8 +17,12 @@ pub struct ExportArgs {
     #[command(flatten)]
     scene: SceneArgs,
     /// Directory to write `clouds.vol` and `scene.xml` into (created if missing).
-    #[arg(long)]
-    out: PathBuf,
+    #[arg(long, required_unless_present = "sprites")]
+    out: Option<PathBuf>,
+    /// Write the scene's sprite clouds (hand-made, model file and the field's around the camera)
+    /// to this sprite model file instead; `sprites.model` draws it.
+    #[arg(long, conflicts_with = "out")]
+    sprites: Option<PathBuf>,
     /// Voxels along the longest side of the box.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(2..=2048))]
     resolution: u32,
@@ -41,7 +48,7 @@ fn export_box(field: &CloudField, camera: Vec3, size_m: f32) -> Option<(Vec3, Ve
         .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
 }
 
-/// Samples the field and writes the Mitsuba scene.
+/// Samples the field and writes the Mitsuba scene, or writes the sprite model.
 pub fn run(args: ExportArgs) -> Result<()> {
     let mut stages = Stages::new();
     let doc = stages.run("loading scene", || args.scene.load(&[]))?;
@@ -50,6 +57,11 @@ pub fn run(args: ExportArgs) -> Result<()> {
         CloudField::new(scene, &doc.resolve_path(""))
             .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))
     })?;
+    let out = match (&args.sprites, &args.out) {
+        (Some(path), _) => return write_sprites(&doc, &field, path, stages),
+        (None, Some(out)) => out,
+        (None, None) => return Err(anyhow!("give --out DIR (Mitsuba) or --sprites FILE")),
+    };
     let camera = Vec3::from_array(scene.camera.position_m);
     let (min, max) = export_box(&field, camera, args.size_km * 1000.0)
         .ok_or_else(|| anyhow!("the scene has no clouds to export"))?;
@@ -77,9 +89,31 @@ pub fn run(args: ExportArgs) -> Result<()> {
         ..sigma
     };
     let path = stages.run("writing", || {
-        Ok(write_mitsuba_scene(&args.out, scene, &normalised, peak)?)
+        Ok(write_mitsuba_scene(out, scene, &normalised, peak)?)
     })?;
     eprintln!("wrote {} (peak extinction {peak:.4} m^-1)", path.display());
+    stages.print();
+    Ok(())
+}
+
+/// Writes the scene's sprite clouds as a model file at `path`.
+fn write_sprites(
+    doc: &cloudscape::scene::SceneDocument,
+    field: &CloudField,
+    path: &std::path::Path,
+    mut stages: Stages,
+) -> Result<()> {
+    let clouds = stages.run("making sprite clouds", || {
+        scene_clouds(&doc.scene, field, &doc.resolve_path(""))
+            .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))
+    })?;
+    stages.run("writing", || Ok(ModelFile::of(&clouds).write(path)?))?;
+    let sprites: usize = clouds.iter().map(|c| c.sprites.len()).sum();
+    eprintln!(
+        "wrote {} clouds, {sprites} sprites to {}",
+        clouds.len(),
+        path.display()
+    );
     stages.print();
     Ok(())
 }

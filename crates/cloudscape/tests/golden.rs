@@ -143,6 +143,48 @@ fn particles_from_above_and_inside() {
     );
 }
 
+/// The sprite technique over the default scene's field clouds, with the impostor ring holding the
+/// clouds beyond 6 km, from the ground, from above the layer and from inside a cloud.
+#[test]
+fn sprites_from_the_ground_above_and_inside() {
+    let sprites = [
+        "render.technique=sprites",
+        "sprites.distance_m=20000",
+        "sprites.ring_radius_m=6000",
+    ];
+    check("sprites_ground", &render("", Path::new("."), &sprites));
+    let above = ["camera.position_m=[0,6500,0]", "camera.pitch_deg=-35"];
+    check(
+        "sprites_above",
+        &render("", Path::new("."), &[&sprites[..], &above].concat()),
+    );
+    let inside = ["camera.position_m=[4000,2300,-3000]", "camera.pitch_deg=3"];
+    check(
+        "sprites_inside",
+        &render("", Path::new("."), &[&sprites[..], &inside].concat()),
+    );
+}
+
+/// Hand-made sprite clouds of three types built from boxes, one with artist colour levels and
+/// an artist ambient colour, and the single-billboard level of detail of the same clouds.
+#[test]
+fn hand_made_sprite_clouds_and_their_billboards() {
+    let toml = "[render]\ntechnique = \"sprites\"\n[sprites]\nfield_clouds = false\n\
+        [camera]\nposition_m = [0.0, 800.0, 4000.0]\nlook_at_m = [0.0, 1800.0, -3000.0]\n\
+        [[sprite_clouds]]\ntype = \"cumulonimbus\"\ncenter_m = [-2500.0, 2500.0, -4000.0]\nseed = 4\n\
+        boxes = [{ center_m = [0.0, -1000.0, 0.0], size_m = [2000.0, 1000.0, 2000.0] }, { center_m = [0.0, 300.0, 0.0], size_m = [1400.0, 1600.0, 1400.0] }, { center_m = [0.0, 1400.0, 0.0], size_m = [3200.0, 500.0, 2400.0] }]\n\
+        [[sprite_clouds]]\ntype = \"cumulus_mediocris\"\ncenter_m = [1200.0, 1700.0, -2000.0]\nseed = 5\n\
+        color_levels = [[0.0, 0.25, 0.25, 0.3, 1.0], [0.25, 0.45, 0.45, 0.5, 1.0], [0.5, 0.7, 0.7, 0.72, 1.0], [0.75, 0.9, 0.9, 0.9, 1.0], [1.0, 1.0, 1.0, 1.0, 1.0]]\n\
+        boxes = [{ center_m = [0.0, 0.0, 0.0], size_m = [1400.0, 600.0, 1000.0] }, { center_m = [200.0, 450.0, 0.0], size_m = [800.0, 500.0, 700.0] }]\n\
+        [[sprite_clouds]]\ntype = \"stratus\"\ncenter_m = [2500.0, 1200.0, -6000.0]\nseed = 6\n\
+        boxes = [{ center_m = [0.0, 0.0, 0.0], size_m = [5000.0, 250.0, 3000.0] }]\n";
+    check("sprites_hand_made", &render(toml, Path::new("."), &[]));
+    check(
+        "sprites_billboards",
+        &render(toml, Path::new("."), &["sprites.lod=billboards"]),
+    );
+}
+
 /// The goldens directory exists (a typo in the path would make every golden missing).
 #[test]
 fn goldens_directory_exists() {

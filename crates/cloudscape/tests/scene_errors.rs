@@ -265,7 +265,7 @@ fn a_sprite_cloud_without_boxes_is_located() {
     let error = rejected(
         "[[sprite_clouds]]\ntype = \"cumulus_congestus\"\ncenter_m = [0.0, 900.0, 0.0]\nboxes = [{ center_m = [0.0, 0.0, 0.0], size_m = [100.0, -1.0, 100.0] }]\n",
         4,
-        71,
+        57,
         "sprite_clouds.0.boxes.0.size_m.1",
     );
     assert_mentions(&error, &["> 0"]);

@@ -252,3 +252,56 @@ fn flythrough_options_need_flythrough() {
     let args = ["bench", "--reference-spp", "4"];
     assert_args_rejected("bench-reference-spp", &args, false, &["--flythrough"]);
 }
+
+#[test]
+fn export_sprites_writes_a_model_that_a_scene_renders_and_a_broken_one_is_located() {
+    let scratch = Scratch::new("export_sprites");
+    let scene = "[sprites]\ndistance_m = 4000.0\n";
+    std::fs::write(scratch.join("scene.toml"), scene).expect("write scene");
+    let run = cloudscape(
+        scratch.path(),
+        &["export", "scene.toml", "--sprites", "clouds.sprites.toml"],
+        false,
+    );
+    assert!(run.success, "{}", run.stderr);
+    let model = std::fs::read_to_string(scratch.join("clouds.sprites.toml")).expect("written");
+    assert!(model.contains("format = \"cloudscape sprite model\""));
+    let drawn = "layers = []\n[render]\ntechnique = \"sprites\"\n[sprites]\nfield_clouds = false\n\
+        model = \"clouds.sprites.toml\"\n";
+    std::fs::write(scratch.join("drawn.toml"), drawn).expect("write scene");
+    let run = render(scratch.path(), Some("drawn.toml"), "drawn.png");
+    assert!(run.success, "{}", run.stderr);
+    let clear = drawn.replace("model = \"clouds.sprites.toml\"\n", "");
+    std::fs::write(scratch.join("clear.toml"), clear).expect("write scene");
+    let run = render(scratch.path(), Some("clear.toml"), "clear.png");
+    assert!(run.success, "{}", run.stderr);
+    let read = |name: &str| LdrImage::read_png(&scratch.join(name)).expect("a PNG");
+    assert_ne!(
+        read("drawn.png").pixels,
+        read("clear.png").pixels,
+        "the model drew nothing"
+    );
+    // A sprite with a texture past the sheet: the model file's line and key, and no image.
+    let broken = model.replacen("texture = ", "texture = 9", 1);
+    std::fs::write(scratch.join("clouds.sprites.toml"), broken).expect("write model");
+    std::fs::remove_file(scratch.join("drawn.png")).expect("remove");
+    let run = render(scratch.path(), Some("drawn.toml"), "drawn.png");
+    let before = [
+        "clear.png",
+        "clear.toml",
+        "clouds.sprites.toml",
+        "drawn.toml",
+        "scene.toml",
+    ];
+    assert_rejected(
+        &scratch,
+        &before,
+        &run,
+        &[
+            "sprites.model",
+            "clouds.sprites.toml:",
+            "clouds.0.sprites.0.texture",
+            "allowed 0..15",
+        ],
+    );
+}

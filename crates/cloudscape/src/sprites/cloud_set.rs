@@ -4,6 +4,7 @@
 //! group's light for the current sun.
 
 use std::collections::BTreeMap;
+use std::path::Path;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
@@ -11,9 +12,10 @@ use glam::{Vec2, Vec3, Vec4};
 use super::from_field::{FieldTiling, TileKey};
 use super::model::SpriteCloud;
 use super::shading::{self, ColorLevel, LEVELS, SunLight, physical_levels};
-use crate::field::CloudField;
+use super::{CloudModel, ModelFile};
+use crate::field::{CloudField, FieldError};
 use crate::particles::DEFAULT_EXTINCTION_PER_M;
-use crate::scene::{Scene, SpriteLod};
+use crate::scene::{Scene, SpriteCloudSpec, SpriteLod};
 
 /// `layer` of a sprite no wind carries.
 pub const NO_LAYER: u32 = 4;
@@ -36,8 +38,8 @@ pub struct GpuSprite {
     pub texture: u32,
     /// Index of its cloud.
     pub cloud: u32,
-    /// Opacity 0..1.
-    pub opacity: f32,
+    /// Optical depth through its densest column.
+    pub optical_depth: f32,
     /// Its group's directional factor, 0..1.
     pub directional: f32,
     /// Direct sun reaching its group, 0..1.
@@ -245,7 +247,7 @@ impl CloudSet {
             .sprites
             .iter()
             .map(|s| {
-                let light = lights[s.group as usize];
+                let group = lights[s.group as usize];
                 GpuSprite {
                     position_m: cloud.center_m + s.offset_m,
                     layer,
@@ -253,9 +255,9 @@ impl CloudSet {
                     rotation_rad: s.rotation_rad,
                     texture: s.texture,
                     cloud: 0,
-                    opacity: s.opacity,
-                    directional: light.directional,
-                    sun_transmittance: light.sun_transmittance,
+                    optical_depth: s.opacity * sprite_optical_depth(light, s.size_m.x),
+                    directional: group.directional,
+                    sun_transmittance: group.sun_transmittance,
                 }
             })
             .collect();
@@ -273,6 +275,74 @@ impl CloudSet {
             .chain(self.tiles.values().flatten().cloned())
             .collect()
     }
+}
+
+/// Every sprite cloud of `scene` at its time: the hand-made ones, those of its model file (files
+/// resolve against `base_dir`) and the field's around the camera (what `cloudscape export
+/// --sprites` writes).
+pub fn scene_clouds(
+    scene: &Scene,
+    field: &CloudField,
+    base_dir: &Path,
+) -> Result<Vec<SpriteCloud>, FieldError> {
+    let mut clouds: Vec<SpriteCloud> = authored_clouds(scene, base_dir)?
+        .into_iter()
+        .map(|(cloud, _)| cloud)
+        .collect();
+    if scene.sprites.field_clouds {
+        let tiling = FieldTiling {
+            tile_m: scene.sprites.cloud_size_m,
+            distance_m: scene.sprites.distance_m,
+            time_s: scene.render.time_s,
+        };
+        let camera = glam::Vec3::from_array(scene.camera.position_m);
+        let keys = tiling.tiles_around(field, camera);
+        clouds.extend(tiling.clouds(field, &keys).into_iter().map(|(_, c)| c));
+    }
+    Ok(clouds)
+}
+
+/// A hand-made or model-file cloud with its colour levels (None: derived).
+pub type Authored = (SpriteCloud, Option<[ColorLevel; LEVELS]>);
+
+/// The hand-made clouds of `scene` and those of its model file.
+pub fn authored_clouds(scene: &Scene, base_dir: &Path) -> Result<Vec<Authored>, FieldError> {
+    let mut clouds: Vec<_> = scene
+        .sprite_clouds
+        .iter()
+        .map(|spec| (CloudModel::from_spec(spec).generate(None), levels_of(spec)))
+        .collect();
+    if let Some(path) = &scene.sprites.model {
+        let file = ModelFile::read(&base_dir.join(path)).map_err(|e| FieldError {
+            key_path: "sprites.model".into(),
+            message: e.to_string(),
+        })?;
+        clouds.extend(file.clouds().into_iter().map(|c| (c, None)));
+    }
+    Ok(clouds)
+}
+
+/// A hand-made cloud's colour levels, when the scene gives them.
+fn levels_of(spec: &SpriteCloudSpec) -> Option<[ColorLevel; LEVELS]> {
+    let given = spec.color_levels.as_ref()?;
+    Some(std::array::from_fn(|i| {
+        let [height, r, g, b, a] = given[i];
+        ColorLevel {
+            height,
+            rgba: Vec4::new(r, g, b, a),
+        }
+    }))
+}
+
+/// Sprite optical depth at most: beyond it a puff's core is opaque anyway, and its soft edge is
+/// kept (a sphere of cloud as dense as its layer would be a hard-edged ball).
+pub const MAX_SPRITE_OPTICAL_DEPTH: f32 = 3.0;
+
+/// Optical depth through the densest column of a sprite `width_m` wide of the light's matter at
+/// its mean density.
+fn sprite_optical_depth(light: &SunLight, width_m: f32) -> f32 {
+    (light.extinction_per_m * shading::MEAN_RELATIVE_DENSITY * width_m)
+        .min(MAX_SPRITE_OPTICAL_DEPTH)
 }
 
 /// What the clouds depend on besides the camera, time and sun: a change rebuilds them all.
@@ -308,7 +378,7 @@ mod tests {
                 rotation_rad,
                 texture,
                 cloud,
-                opacity,
+                optical_depth,
                 directional,
                 sun_transmittance,
             }

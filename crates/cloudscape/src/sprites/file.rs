@@ -84,6 +84,11 @@ impl ModelFile {
         )
     }
 
+    /// Writes the file to `path` atomically: a reader never sees a partial file.
+    pub fn write(&self, path: &std::path::Path) -> std::io::Result<()> {
+        crate::fsutil::write_bytes_atomically(path, self.to_toml().as_bytes())
+    }
+
     /// Parses and validates `text` (named `origin` in errors).
     pub fn parse(text: &str, origin: &str) -> Result<ModelFile, SceneError> {
         parse_toml_document(text, origin, ModelFile::check)

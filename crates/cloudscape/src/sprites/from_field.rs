@@ -27,7 +27,7 @@ use crate::particles::generate::world_point;
 
 /// Normalised coarse density (of the layer's densest) over which a sprite's opacity ramps from 0
 /// to full: its presence, `saturate(density / ramp)`.
-pub const PRESENCE_RAMP: f32 = 0.25;
+pub const PRESENCE_RAMP: f32 = 0.12;
 /// Sprites thinner than this presence are dropped.
 pub const MIN_PRESENCE: f32 = 0.02;
 /// A field cloud's nominal height, which its cull radius and sprite sizes are fractions of, as a
@@ -212,4 +212,88 @@ fn column_boxes(cloud: &SpriteCloud, tile_m: f32) -> Vec<SpriteBox> {
         }
     }
     boxes
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+    use std::path::Path;
+
+    fn field(coverage: f32) -> CloudField {
+        let mut scene = Scene::default();
+        scene.layers[0].coverage = coverage;
+        CloudField::new(&scene, Path::new(".")).unwrap()
+    }
+
+    const TILING: FieldTiling = FieldTiling {
+        tile_m: 1500.0,
+        distance_m: 5000.0,
+        time_s: 0.0,
+    };
+
+    #[test]
+    fn field_clouds_sit_where_the_field_is_cloudy_and_form_from_their_cores() {
+        let (thin, thick) = (field(0.35), field(0.6));
+        let keys = TILING.tiles_around(&thin, glam::Vec3::ZERO);
+        let clouds = TILING.clouds(&thin, &keys);
+        assert!(
+            !clouds.is_empty() && clouds.len() < keys.len(),
+            "{} of {}",
+            clouds.len(),
+            keys.len()
+        );
+        let mut grown = 0;
+        for (key, cloud) in &clouds {
+            for s in &cloud.sprites {
+                let p = cloud.center_m + s.offset_m;
+                assert!(
+                    thin.coarse_extinction_per_m(p, 0.0) > 0.0,
+                    "a sprite in clear air at {p}"
+                );
+                assert!(cloud.boxes.iter().any(|b| {
+                    ((s.offset_m - b.center_m).abs())
+                        .cmple(b.size_m * 0.5 + 1.0)
+                        .all()
+                }));
+            }
+            // More coverage keeps every sprite where it was, at least as opaque, and adds more:
+            // clouds grow from their cores outward and dissipate back from their edges.
+            let more = TILING
+                .cloud(&thick, *key)
+                .expect("a cloud stays when coverage grows");
+            for s in &cloud.sprites {
+                let same = more
+                    .sprites
+                    .iter()
+                    .find(|m| m.offset_m.distance(s.offset_m) < 1e-2);
+                let same = same.expect("a sprite vanished as coverage grew");
+                assert!(same.opacity >= s.opacity - 1e-6);
+            }
+            grown += more.sprites.len() - cloud.sprites.len();
+        }
+        assert!(grown > 0);
+    }
+
+    #[test]
+    fn a_clear_sky_makes_no_field_clouds() {
+        let clear = field(0.0);
+        let keys = TILING.tiles_around(&clear, glam::Vec3::ZERO);
+        assert!(TILING.clouds(&clear, &keys).is_empty());
+    }
+
+    #[test]
+    fn tiles_ride_the_wind() {
+        let f = field(0.45);
+        let later = FieldTiling {
+            time_s: 600.0,
+            ..TILING
+        };
+        let wind = f.layers[0].wind_m_per_s * 600.0;
+        let eye = glam::Vec3::new(wind.x, 0.0, wind.y);
+        assert_eq!(
+            TILING.tiles_around(&f, glam::Vec3::ZERO),
+            later.tiles_around(&f, eye)
+        );
+    }
 }

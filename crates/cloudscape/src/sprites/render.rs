@@ -9,12 +9,10 @@ use std::path::Path;
 use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, Vec2, Vec3, Vec4};
 
-use super::cloud_set::{CloudSet, GpuCloud, GpuSprite};
+use super::cloud_set::{CloudSet, GpuCloud, GpuSprite, authored_clouds};
 use super::impostors::{ASPECT, SECTORS, SectorView};
-use super::shading::{ColorLevel, LEVELS};
 use super::textures::{SHEET_TEXELS, bake_sheet};
 use super::views::{Reach, SortedView, ViewUniform, sector_elevations, sort_view, wind_offsets_m};
-use super::{CloudModel, ModelFile};
 use crate::field::FieldError;
 use crate::frame::{Shared, SharedSlots};
 use crate::gpu::pipeline::{
@@ -25,7 +23,7 @@ use crate::gpu::pipeline::{
 use crate::gpu::{GpuContext, PassTimer};
 use crate::optics::PhaseLobes;
 use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
-use crate::scene::{Scene, SpriteCloudSpec};
+use crate::scene::Scene;
 use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 
 /// The timed passes of a frame, in order (the impostor pass only in frames that render one).
@@ -541,41 +539,6 @@ impl SpriteRenderer {
         ring.pending.clear();
         self.ring = Some(ring);
     }
-}
-
-/// A hand-made or model-file cloud with its colour levels (None: derived).
-type Authored = (super::SpriteCloud, Option<[ColorLevel; LEVELS]>);
-
-/// The hand-made clouds of `scene` and those of its model file.
-fn authored_clouds(
-    scene: &Scene,
-    base_dir: &Path,
-) -> Result<Vec<Authored>, FieldError> {
-    let mut clouds: Vec<_> = scene
-        .sprite_clouds
-        .iter()
-        .map(|spec| (CloudModel::from_spec(spec).generate(None), levels_of(spec)))
-        .collect();
-    if let Some(path) = &scene.sprites.model {
-        let file = ModelFile::read(&base_dir.join(path)).map_err(|e| FieldError {
-            key_path: "sprites.model".into(),
-            message: e.to_string(),
-        })?;
-        clouds.extend(file.clouds().into_iter().map(|c| (c, None)));
-    }
-    Ok(clouds)
-}
-
-/// A hand-made cloud's colour levels, when the scene gives them.
-fn levels_of(spec: &SpriteCloudSpec) -> Option<[ColorLevel; LEVELS]> {
-    let given = spec.color_levels.as_ref()?;
-    Some(std::array::from_fn(|i| {
-        let [height, r, g, b, a] = given[i];
-        ColorLevel {
-            height,
-            rgba: Vec4::new(r, g, b, a),
-        }
-    }))
 }
 
 /// Uploads the baked puff sheet.

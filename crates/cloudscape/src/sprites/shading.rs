@@ -158,12 +158,15 @@ impl SunLight {
 }
 
 /// Wang 2003's directional factor of a group at `offset_m` from its cloud's centre, for a cloud of
-/// diameter `diameter_m`: from the multiply scattered light that crosses the cloud on the far side
-/// to 1 on the side facing the sun.
+/// diameter `diameter_m`: from the two-stream diffuse transmittance across the cloud on the far
+/// side (the light that diffuses through a slab that thick) to 1 on the side facing the sun.
 pub fn wang_group_light(light: &SunLight, offset_m: Vec3, diameter_m: f32) -> GroupLight {
     let facing = 0.5 + 0.5 * light.sun.dot(offset_m.normalize_or_zero());
-    let tau_across = light.extinction_per_m * MEAN_RELATIVE_DENSITY * diameter_m;
-    light.after(tau_across * (1.0 - facing))
+    let tau = light.extinction_per_m * MEAN_RELATIVE_DENSITY * diameter_m * (1.0 - facing);
+    GroupLight {
+        directional: diffuse_transmittance(tau, light.g),
+        sun_transmittance: (-tau).exp(),
+    }
 }
 
 /// A field cloud's group at world point `p` (the layer's wind frame at time 0): its light after
@@ -241,7 +244,7 @@ mod tests {
         let far = wang_group_light(&light, -Vec3::X * 300.0, 1000.0);
         assert_eq!((near.directional, near.sun_transmittance), (1.0, 1.0));
         assert!(far.directional < side.directional && side.directional < 1.0);
-        assert!((far.directional - light.multiple_scattering(25.0)).abs() < 1e-6);
+        assert!((far.directional - diffuse_transmittance(25.0, 0.8)).abs() < 1e-6);
         assert!(far.sun_transmittance < 1e-6);
         // One octave is Beer-Lambert; more octaves carry light deeper.
         let beer = SunLight {

@@ -12,7 +12,7 @@ struct Sprite {
     rotation_rad: f32,          // about the view axis
     texture: u32,               // tile of the puff sheet, 0..15
     cloud: u32,                 // index into `clouds`
-    opacity: f32,               // type opacity times presence (formation)
+    optical_depth: f32,         // through its densest column: type opacity x presence x size
     directional: f32,           // its shading group's directional factor, 0..1
     sun_transmittance: f32,     // direct sun reaching its group, 0..1 (silver lining)
 }
@@ -55,7 +55,8 @@ struct Varying {
     @location(0) uv: vec2<f32>,                 // on the puff sheet
     @location(1) diffuse: vec3<f32>,            // ambient + directional radiance
     @location(2) single: vec3<f32>,             // single-scattered sun (silver lining)
-    @location(3) opacity: f32,
+    @location(3) opacity: f32,                  // fades and the level's opacity
+    @location(6) optical_depth: f32,            // the sprite's, through its densest column
     @location(4) distance_m: f32,
     @location(5) soft_m: f32,
 }
@@ -123,10 +124,13 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     let p = centre + (right * turned.x * s.size_m.x + up * turned.y * s.size_m.y) * 0.5;
 
     // Fades: the sprite vanishes as the eye passes through it (Wang 2003; FlightGear fades sprites
-    // between 100 m and 10 m); a locked sprite seen edge-on turns transparent (Wang: the dot
+    // between 100 m and 10 m from the eye); a locked sprite seen edge-on turns transparent (Wang: the dot
     // product of the lock angle and the angle to the camera); distant clouds fade out.
+    // A locked sprite faces along the view, so the eye passes through it when its plane reaches
+    // the eye: it fades with its distance ahead, and stays whole until then (no hole opens).
     let radius = 0.5 * max(s.size_m.x, s.size_m.y);
-    let through = smoothstep(0.1 * radius, 0.6 * radius, d);
+    let ahead = dot(-to_eye, view.forward);
+    let through = mix(smoothstep(0.1 * radius, 0.6 * radius, d), smoothstep(0.0, 0.35 * radius, ahead), lock);
     let edge_on = mix(1.0, abs(dot(normal, to_eye / d)), lock);
     let horizontal = length(to_eye.xz);
     let far = 1.0 - smoothstep(view.fade_start_m, view.fade_end_m, horizontal);
@@ -143,7 +147,8 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     out.uv = (tile + corner * vec2<f32>(0.5, -0.5) + 0.5) / SHEET_TILES;
     out.diffuse = level.rgb * maxima[0] + s.directional * maxima[1];
     out.single = settings.albedo * environment_sun_irradiance(p) * s.sun_transmittance * phase;
-    out.opacity = s.opacity * level.a * through * edge_on * far;
+    out.opacity = level.a * through * edge_on * far;
+    out.optical_depth = s.optical_depth;
     out.distance_m = length(p - view.eye_m);
     out.soft_m = 0.25 * radius;
     return out;
@@ -151,15 +156,17 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
 
 @fragment
 fn fs_sprite(in: Varying) -> SpriteTargets {
+    // The sheet holds column density normalised to 1 (sprites/textures.rs).
     let cover = textureSample(puffs, puff_sampler, in.uv).r;
-    var alpha = cover * in.opacity;
+    var alpha = (1.0 - exp(-in.optical_depth * cover)) * in.opacity;
     if view.host_depth_test == 1u {
         let texel = in.clip.xy;
         let depth = textureLoad(host_depth, vec2<i32>(sprite_frame_pixel(texel)), 0).x;
         alpha *= sprite_host_fade(depth, texel, in.distance_m, in.soft_m);
     }
-    // Thin parts of a puff scatter the direct sun once toward the eye; its thick core's light is
-    // the diffuse term's.
-    let radiance = alpha * (in.diffuse + (1.0 - cover) * in.single);
+    // Thin parts of a puff scatter the direct sun once toward the eye (premultiplied, E p tau ~
+    // E p alpha for thin matter); its thick core's light is the diffuse term's.
+    let thin = (1.0 - cover) * (1.0 - cover);
+    let radiance = alpha * (in.diffuse + thin * in.single);
     return sprite_targets(radiance, alpha, in.distance_m);
 }

@@ -136,7 +136,7 @@ impl CloudType {
                 sprites: 40,
                 footprint: 4.0,
                 tiers: 1,
-                width: (0.8, 1.4),
+                width: (1.0, 1.8),
                 aspect: (0.5, 0.8),
                 textures: SOLID | BLURRY,
                 ..base
@@ -145,7 +145,7 @@ impl CloudType {
                 sprites: 30,
                 footprint: 6.0,
                 tiers: 1,
-                width: (1.2, 2.0),
+                width: (1.5, 2.5),
                 aspect: (0.35, 0.6),
                 rotation_deg: (-15.0, 15.0),
                 textures: BLURRY,

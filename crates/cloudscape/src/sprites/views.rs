@@ -141,7 +141,7 @@ pub fn sort_view(
     let mut keyed: Vec<(f32, u32)> = Vec::new();
     let mut overdraw = 0.0f64;
     for (i, s) in set.sprites.iter().enumerate() {
-        if !keep_cloud[s.cloud as usize] || s.opacity <= 0.0 {
+        if !keep_cloud[s.cloud as usize] || s.optical_depth <= 0.0 {
             continue;
         }
         let to = sprite_now(s, offsets) - eye_m;
