@@ -23,22 +23,25 @@ for i, frame in enumerate(frames):
 strip.save(sys.argv[2])
 PY
 rm -rf "$frames"
-# The ray marcher beside the particle technique: the default scene and the layer from above.
-pair=$(mktemp -d)
-for technique in raymarch particles; do
-    "$cloudscape" render --technique "$technique" --width 640 --height 360 --out "$pair/ground-$technique.png"
+# The three techniques side by side: the default scene, the layer from above, inside the layer.
+trio=$(mktemp -d)
+for technique in raymarch particles sprites; do
+    "$cloudscape" render --technique "$technique" --width 640 --height 360 --out "$trio/ground-$technique.png"
     "$cloudscape" render scenes/above-the-layer.toml --technique "$technique" --width 640 --height 360 \
-        --out "$pair/above-$technique.png"
+        --out "$trio/above-$technique.png"
+    "$cloudscape" render scenes/inside-the-layer.toml --technique "$technique" --width 640 --height 360 \
+        --out "$trio/inside-$technique.png"
 done
-python3 - "$pair" "$out/raymarch-vs-particles.png" <<'PY'
+python3 - "$trio" "$out/techniques.png" <<'PY'
 import sys
 from PIL import Image
-names = ["ground-raymarch", "ground-particles", "above-raymarch", "above-particles"]
-images = [Image.open(f"{sys.argv[1]}/{n}.png").convert("RGB") for n in names]
-w, h = images[0].size
-grid = Image.new("RGB", (2 * w, 2 * h))
-for i, image in enumerate(images):
-    grid.paste(image, ((i % 2) * w, (i // 2) * h))
+rows, columns = ["ground", "above", "inside"], ["raymarch", "particles", "sprites"]
+images = [[Image.open(f"{sys.argv[1]}/{r}-{c}.png").convert("RGB") for c in columns] for r in rows]
+w, h = images[0][0].size
+grid = Image.new("RGB", (len(columns) * w, len(rows) * h))
+for y, row in enumerate(images):
+    for x, image in enumerate(row):
+        grid.paste(image, (x * w, y * h))
 grid.save(sys.argv[2])
 PY
-rm -rf "$pair"
+rm -rf "$trio"

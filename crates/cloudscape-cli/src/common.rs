@@ -24,7 +24,7 @@ pub struct SceneArgs {
     /// Image height in pixels (same as `--set render.height=H`).
     #[arg(long)]
     pub height: Option<u32>,
-    /// Renderer: raymarch or particles (same as `--set render.technique=NAME`).
+    /// Renderer: raymarch, particles or sprites (same as `--set render.technique=NAME`).
     #[arg(long, value_name = "NAME")]
     pub technique: Option<String>,
 }

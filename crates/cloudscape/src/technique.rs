@@ -18,7 +18,7 @@ pub struct TechniqueStats {
     /// Output texels written.
     pub pixels: u32,
     /// Extinction evaluations along view rays per texel (for particles: particle segments
-    /// blended per texel).
+    /// blended per texel; for sprites: layers of sprites per texel, from their projected areas).
     pub density_samples_per_pixel: f64,
     /// Primitives drawn (particles, sprites); None for techniques without them.
     pub primitives: Option<u32>,

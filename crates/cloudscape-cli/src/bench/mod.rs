@@ -82,7 +82,7 @@ struct Report {
     passes: Vec<Stat>,
     frame_wall: Stat,
     /// Extinction evaluations along view rays per pixel (the last frame; for particles,
-    /// particle segments blended per pixel).
+    /// particle segments blended per pixel; for sprites, layers of sprites per pixel).
     density_samples_per_pixel: f64,
     /// Particles (or other primitives) drawn in the last frame.
     primitives: Option<u32>,
@@ -219,7 +219,7 @@ fn print_report(report: &Report) {
     }
     let samples = report.density_samples_per_pixel;
     match report.primitives {
-        Some(n) => println!("particles: {n}; particle segments blended per pixel: {samples:.1}"),
+        Some(n) => println!("primitives drawn: {n}; blended per pixel: {samples:.1}"),
         None => println!("view-ray density samples per pixel: {samples:.1}"),
     }
 }

@@ -5,6 +5,7 @@
 //! count and the seed, so tuning the ray marcher reruns only the GPU side.
 
 mod particles;
+mod sprites;
 
 use crate::common::{GpuArgs, SceneArgs};
 use crate::compare::Comparison;
@@ -15,8 +16,8 @@ use cloudscape::field::noise::perlin;
 use cloudscape::field::{CloudField, VoxelGrid};
 use cloudscape::gpu::GpuContext;
 use cloudscape::image::{HdrImage, write_image};
-use cloudscape::renderer::SceneRenderer;
-use cloudscape::scene::{Scene, SceneDocument};
+use cloudscape::renderer::{Rendered, SceneRenderer};
+use cloudscape::scene::{Scene, SceneDocument, Technique};
 use cloudscape::temporal::halton;
 use cloudscape_reference::medium::Medium;
 use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer, ProgressiveRender};
@@ -123,6 +124,7 @@ struct Row {
     spp: f64,
     gpu_ms: f64,
     particles: Option<particles::ParticleRow>,
+    sprites: sprites::SpriteRow,
 }
 
 /// Renders and compares every canonical scene, then writes the report.
@@ -153,6 +155,23 @@ pub fn run(args: ReportArgs) -> Result<()> {
     Ok(())
 }
 
+/// A technique's render of `doc` (its technique replaced by `technique`): the renderer, the
+/// images and the wall time of the GPU render, ms.
+fn render_with(
+    doc: &SceneDocument,
+    ctx: &GpuContext,
+    technique: Technique,
+) -> Result<(SceneRenderer, Scene, Rendered, f64)> {
+    let mut scene = doc.scene.clone();
+    scene.render.technique = technique;
+    let mut renderer = SceneRenderer::new(ctx, &scene, &doc.resolve_path(""))
+        .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
+    let start = Instant::now();
+    let gpu = renderer.render(ctx, &scene, |_| {});
+    let gpu_ms = start.elapsed().as_secs_f64() * 1e3;
+    Ok((renderer, scene, gpu, gpu_ms))
+}
+
 /// Loads a canonical scene at the report's size.
 fn load(canonical: &Canonical, args: &ReportArgs, voxel_dir: &Path) -> Result<SceneDocument> {
     let (file, overrides): (Option<PathBuf>, &[&str]) = match canonical.source {
@@ -179,11 +198,7 @@ fn scene_row(
     images: &Path,
 ) -> Result<Row> {
     let scene = &doc.scene;
-    let mut renderer = SceneRenderer::new(ctx, scene, &doc.resolve_path(""))
-        .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
-    let start = Instant::now();
-    let gpu = renderer.render(ctx, scene, |_| {});
-    let gpu_ms = start.elapsed().as_secs_f64() * 1e3;
+    let (_, _, gpu, gpu_ms) = render_with(doc, ctx, scene.render.technique)?;
     let reference = cached_reference(doc, args)?;
     let full = average(&reference.halves);
     let image_path = |kind: &str| images.join(format!("{}-{kind}.png", canonical.name));
@@ -201,6 +216,7 @@ fn scene_row(
     );
     let key = cache_key(doc, args)?;
     let particles = particles::row(canonical.name, doc, ctx, (args, &key), (&full, images))?;
+    let sprites = sprites::row(canonical.name, doc, ctx, (&full, images))?;
     Ok(Row {
         name: canonical.name,
         title: canonical.title,
@@ -210,6 +226,7 @@ fn scene_row(
         spp: reference.spp,
         gpu_ms,
         particles,
+        sprites,
     })
 }
 
@@ -346,7 +363,9 @@ const PATH_TRACED_KEYS: [(&str, &[&str]); 2] = [
 /// `scene` as a TOML table without the settings only the real-time techniques read.
 fn path_traced_part(scene: &Scene) -> Result<toml::Table> {
     let mut table = toml::Table::try_from(scene)?;
-    table.remove("particles");
+    for real_time_only in ["particles", "sprites", "sprite_clouds"] {
+        table.remove(real_time_only);
+    }
     for (section, kept) in PATH_TRACED_KEYS {
         if let Some(toml::Value::Table(t)) = table.get_mut(section) {
             t.retain(|key, _| kept.contains(&key));
@@ -464,6 +483,7 @@ fn markdown(rows: &[Row], args: &ReportArgs, adapter: &str) -> String {
         );
     }
     particles::markdown(&mut s, rows.iter().map(|r| (r.title, &r.particles)));
+    sprites::markdown(&mut s, rows.iter().map(|r| (r.title, &r.sprites)));
     let _ = writeln!(
         s,
         "\n## Images\n\nRay marcher | path tracer | HDR-FLIP error (magma)\n"
@@ -474,7 +494,9 @@ fn markdown(rows: &[Row], args: &ReportArgs, adapter: &str) -> String {
             "### {}\n\n| ray marcher | path tracer | HDR-FLIP |\n|---|---|---|\n\
              | ![](realism/{n}-raymarch.png) | ![](realism/{n}-reference.png) | ![](realism/{n}-flip.png) |\n\n\
              | particles | path-traced particles | HDR-FLIP of particles |\n|---|---|---|\n\
-             | ![](realism/{n}-particles.png) | ![](realism/{n}-particle-reference.png) | ![](realism/{n}-particles-flip.png) |\n",
+             | ![](realism/{n}-particles.png) | ![](realism/{n}-particle-reference.png) | ![](realism/{n}-particles-flip.png) |\n\n\
+             | sprites | path tracer | HDR-FLIP of sprites |\n|---|---|---|\n\
+             | ![](realism/{n}-sprites.png) | ![](realism/{n}-reference.png) | ![](realism/{n}-sprites-flip.png) |\n",
             r.title,
             n = r.name
         );
@@ -496,6 +518,8 @@ mod tests {
         tuned.lighting.ambient_scale *= 0.5;
         tuned.render.quality = Quality::Ultra;
         tuned.render.exposure_ev = 2.0;
+        tuned.sprites.ring_radius_m = 0.0;
+        tuned.particles.radius_m *= 2.0;
         assert_eq!(key(&scene), key(&tuned));
         let mut absorbing = scene.clone();
         absorbing.lighting.albedo = 0.9;

@@ -6,22 +6,20 @@
 //!
 //! The total, the particles against the field's reference, is what a user sees.
 
-use super::{ReportArgs, cached_trace};
+use super::{ReportArgs, cached_trace, render_with};
 use crate::compare::Comparison;
-use anyhow::{Result, anyhow};
+use anyhow::Result;
 use cloudscape::gpu::GpuContext;
 use cloudscape::image::{HdrImage, write_image};
 use cloudscape::particles::ParticleTableSpec;
 use cloudscape::particles::density::RadialProfile;
 use cloudscape::particles::generate::{self, Generation};
-use cloudscape::renderer::SceneRenderer;
 use cloudscape::scene::{SceneDocument, Technique};
 use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer};
 use glam::UVec2;
 use std::fmt::Write as _;
 use std::hash::{Hash, Hasher};
 use std::path::Path;
-use std::time::Instant;
 
 /// The particle technique on one scene.
 pub struct ParticleRow {
@@ -47,13 +45,7 @@ pub fn row(
     (args, key): (&ReportArgs, &str),
     (field, images): (&HdrImage, &Path),
 ) -> Result<Option<ParticleRow>> {
-    let mut scene = doc.scene.clone();
-    scene.render.technique = Technique::Particles;
-    let mut renderer = SceneRenderer::new(ctx, &scene, &doc.resolve_path(""))
-        .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
-    let start = Instant::now();
-    let gpu = renderer.render(ctx, &scene, |_| {});
-    let gpu_ms = start.elapsed().as_secs_f64() * 1e3;
+    let (renderer, scene, gpu, gpu_ms) = render_with(doc, ctx, Technique::Particles)?;
     let spec = ParticleTableSpec::from_scene(&scene);
     let generation =
         Generation::from_scene(&scene, RadialProfile::of(&spec.particle).volume_mean());

@@ -222,6 +222,13 @@ impl CloudField {
         );
     }
 
+    /// Computes the base noise's texels now (the only noise [`CloudField::coarse_extinction_per_m`]
+    /// reads), making later coarse evaluations cheap: for CPU work that reads the coarse field at
+    /// many points (sprite clouds).
+    pub fn bake_coarse_noise(&self) {
+        self.base.bake();
+    }
+
     /// Seed of the noise textures (the GPU generates them from it).
     pub fn noise_seed(&self) -> u32 {
         self.base.seed

@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use bytemuck::{Pod, Zeroable};
-use glam::{UVec2, Vec2, Vec3, Vec4};
+use glam::{UVec2, Vec3, Vec4};
 
 use super::cloud_set::{CloudSet, GpuCloud, GpuSprite, authored_clouds};
 use super::impostors::{ASPECT, SECTORS, SectorView};
@@ -463,9 +463,8 @@ impl SpriteRenderer {
             let sorted = sort_view(
                 set,
                 offsets,
-                (eye, sector.forward),
+                (eye, sector.clip_from_world),
                 Reach::Beyond(radius),
-                Vec2::ONE,
             );
             if ring.views[k].write(ctx, &ViewUniform::of_sector(&sector, scene), &sorted) {
                 ring.sector_groups[k] = None;
@@ -647,18 +646,11 @@ impl Technique for SpriteRenderer {
         ctx.queue
             .write_buffer(&self.settings, 0, bytemuck::bytes_of(&settings));
         let view = ViewUniform::of_frame(frame, inputs.grid, scene);
-        let forward = -frame
-            .view_from_world
-            .inverse()
-            .z_axis
-            .truncate()
-            .normalize();
         let reach = match scene.sprites.ring_radius_m {
             r if r > 0.0 => Reach::Within(r),
             _ => Reach::All,
         };
-        let focal = Vec2::new(frame.clip_from_view.x_axis.x, frame.clip_from_view.y_axis.y).abs();
-        let sorted = sort_view(&self.set, &offsets, (eye, forward), reach, focal);
+        let sorted = sort_view(&self.set, &offsets, (eye, frame.clip_from_world()), reach);
         if self.main.write(ctx, &view, &sorted) {
             self.main_group = None;
         }

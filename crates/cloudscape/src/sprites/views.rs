@@ -107,18 +107,18 @@ pub enum Reach {
 pub struct SortedView {
     /// Sprite indices, back to front.
     pub order: Vec<u32>,
-    /// Sum of the sprites' projected areas over the view's area (layers of sprites per texel).
+    /// Sum of the sprites' projected areas (their bounding squares, clipped to the view) over
+    /// the view's area: layers of sprites per texel.
     pub overdraw: f64,
 }
 
-/// The sprites of `set` that `reach` keeps and that lie in front of `eye_m` along `forward`
-/// (within `cos_cone` of it, widened by each sprite's size), farthest first.
+/// The sprites of `set` that `reach` keeps and that the view `clip_from_world` sees (frustum
+/// culled on their bounding circle), farthest from `eye_m` first.
 pub fn sort_view(
     set: &CloudSet,
     offsets: &[Vec4; 4],
-    (eye_m, forward): (Vec3, Vec3),
+    (eye_m, clip_from_world): (Vec3, Mat4),
     reach: Reach,
-    focal: Vec2,
 ) -> SortedView {
     let keep_cloud: Vec<bool> = set
         .cloud_centres
@@ -138,28 +138,34 @@ pub fn sort_view(
             }
         })
         .collect();
+    // Clip-space size of one metre at clip w = 1, per axis.
+    let scale = Vec2::new(
+        clip_from_world.row(0).truncate().length(),
+        clip_from_world.row(1).truncate().length(),
+    );
     let mut keyed: Vec<(f32, u32)> = Vec::new();
     let mut overdraw = 0.0f64;
     for (i, s) in set.sprites.iter().enumerate() {
         if !keep_cloud[s.cloud as usize] || s.optical_depth <= 0.0 {
             continue;
         }
-        let to = sprite_now(s, offsets) - eye_m;
+        let p = sprite_now(s, offsets);
         let radius = 0.5 * s.size_m.max_element();
-        let along = to.dot(forward);
-        if along < -radius {
+        let clip = clip_from_world * p.extend(1.0);
+        let reach = scale * radius;
+        // Outside a side plane of the frustum by more than its radius: never drawn.
+        if clip.x.abs() - reach.x > clip.w || clip.y.abs() - reach.y > clip.w || clip.w < -radius {
             continue;
         }
-        let d = to.length().max(1.0);
-        let depth = along.max(radius * 0.1).max(1.0);
-        overdraw +=
-            f64::from((s.size_m.x * focal.x / depth) * (s.size_m.y * focal.y / depth)).min(4.0);
-        keyed.push((d, i as u32));
+        let w = clip.w.max(radius);
+        let half = (reach / w).min(Vec2::splat(1.0));
+        overdraw += f64::from(half.x * half.y);
+        keyed.push(((p - eye_m).length(), i as u32));
     }
     keyed.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
     SortedView {
         order: keyed.into_iter().map(|(_, i)| i).collect(),
-        overdraw: overdraw / 4.0,
+        overdraw,
     }
 }
 
