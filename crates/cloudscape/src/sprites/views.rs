@@ -150,7 +150,7 @@ pub fn sort_view(
             continue;
         }
         let p = sprite_now(s, offsets);
-        let radius = 0.5 * s.size_m.max_element();
+        let radius = 0.5 * s.size_m.length();
         let clip = clip_from_world * p.extend(1.0);
         let reach = scale * radius;
         // Outside a side plane of the frustum by more than its radius: never drawn.
@@ -189,7 +189,7 @@ pub fn sector_elevations(
         if horizontal < radius_m || flat.dot(Vec2::new(axis.x, axis.z)) < cos_edge * horizontal {
             continue;
         }
-        let half = 0.5 * s.size_m.max_element();
+        let half = 0.5 * s.size_m.length();
         lo = lo.min((to.y - half) / horizontal);
         hi = hi.max((to.y + half) / horizontal);
     }
