@@ -140,21 +140,23 @@ fn export_writes_a_mitsuba_scene_and_a_readable_grid() {
     assert!(grid.max_value() > 0.0, "the exported grid is empty");
 }
 
-/// `bench --techniques raymarch,particles --json`: one report per technique, each with its passes
-/// (where the adapter times them) and frame wall time, the particles' with their count.
+/// `bench --techniques raymarch,particles,sprites --json`: one report per technique, each with its
+/// passes (where the adapter times them) and frame wall time, the particles' and sprites' with
+/// their count.
 #[test]
 fn bench_json_reports_each_pass_and_the_frame_wall_time() {
     let scratch = Scratch::new("bench");
     let mut args = vec!["bench", "--frames", "2", "--warmup", "0", "--json"];
-    args.extend(["--techniques", "raymarch,particles"]);
+    args.extend(["--techniques", "raymarch,particles,sprites"]);
     args.extend(["--set", "particles.table_resolution=low"]);
+    args.extend(["--set", "sprites.distance_m=8000"]);
     args.extend(TINY);
     let run = cloudscape(scratch.path(), &args, true);
     assert!(run.success, "{}", run.stderr);
     let reports: serde_json::Value = serde_json::from_str(&run.stdout).expect("JSON on stdout");
     let reports = reports.as_array().expect("one report per technique");
-    assert_eq!(reports.len(), 2);
-    for (report, technique) in reports.iter().zip(["raymarch", "particles"]) {
+    assert_eq!(reports.len(), 3);
+    for (report, technique) in reports.iter().zip(["raymarch", "particles", "sprites"]) {
         assert_eq!(report["technique"], technique);
         assert_eq!(report["frames"], 2);
         assert_eq!(
@@ -169,6 +171,13 @@ fn bench_json_reports_each_pass_and_the_frame_wall_time() {
             .collect();
         let expected: &[&str] = match (report["timestamps"].as_bool(), technique) {
             (Some(true), "raymarch") => &["raymarch", "compose", "display"],
+            (Some(true), "sprites") => &[
+                "sprites: impostors",
+                "sprites: draw",
+                "sprites: resolve",
+                "compose",
+                "display",
+            ],
             (Some(true), _) => &[
                 "particles: generate",
                 "particles: bin",
@@ -187,6 +196,7 @@ fn bench_json_reports_each_pass_and_the_frame_wall_time() {
     }
     assert!(reports[0]["primitives"].is_null());
     assert!(reports[1]["primitives"].as_u64().is_some_and(|n| n > 1000));
+    assert!(reports[2]["primitives"].as_u64().is_some_and(|n| n > 100));
     assert!(scratch.file_names().is_empty(), "bench wrote a file");
 }
 
