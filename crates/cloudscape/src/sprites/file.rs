@@ -234,14 +234,7 @@ impl FileCloud {
         SpriteCloud {
             cloud_type: self.cloud_type,
             center_m: Vec3::from_array(self.center_m),
-            boxes: self
-                .boxes
-                .iter()
-                .map(|b| SpriteBox {
-                    center_m: Vec3::from_array(b.center_m),
-                    size_m: Vec3::from_array(b.size_m),
-                })
-                .collect(),
+            boxes: self.boxes.iter().map(SpriteBox::from).collect(),
             layer: self.layer,
             sprites: self
                 .sprites

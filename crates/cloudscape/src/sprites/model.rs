@@ -18,6 +18,16 @@ pub struct SpriteBox {
     pub size_m: Vec3,
 }
 
+impl From<&crate::scene::SpriteBoxSpec> for SpriteBox {
+    /// The box a scene or model file describes.
+    fn from(spec: &crate::scene::SpriteBoxSpec) -> SpriteBox {
+        SpriteBox {
+            center_m: Vec3::from_array(spec.center_m),
+            size_m: Vec3::from_array(spec.size_m),
+        }
+    }
+}
+
 impl SpriteBox {
     /// Volume, m^3.
     pub fn volume_m3(&self) -> f32 {
@@ -93,14 +103,7 @@ impl CloudModel {
         CloudModel {
             cloud_type: spec.cloud_type,
             center_m: Vec3::from_array(spec.center_m),
-            boxes: spec
-                .boxes
-                .iter()
-                .map(|b| SpriteBox {
-                    center_m: Vec3::from_array(b.center_m),
-                    size_m: Vec3::from_array(b.size_m),
-                })
-                .collect(),
+            boxes: spec.boxes.iter().map(SpriteBox::from).collect(),
             seed: spec.seed,
             recipe,
         }
