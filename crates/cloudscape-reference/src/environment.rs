@@ -5,7 +5,7 @@ use crate::geometry::{ground_distance, up};
 use crate::sampling::{
     UNIFORM_HEMISPHERE_PDF, UNIFORM_SPHERE_PDF, uniform_hemisphere, uniform_sphere,
 };
-use cloudscape::environment::SkyRadiance;
+use cloudscape::environment::{SkyModel, SkyRadiance, ViewedEnvironment};
 pub use cloudscape::environment::SunDisc;
 use cloudscape::field::PlanetGeometry;
 use cloudscape::frame::Frame;
@@ -26,6 +26,9 @@ pub struct Environment {
     pub planet: PlanetGeometry,
     /// Lambertian albedo of the ground; None without a ground.
     pub ground_albedo: Option<Vec3>,
+    /// The atmosphere seen from the camera, exactly as the GPU's environment (None for the
+    /// analytic skies, which `sky` and `sun` describe alone).
+    pub atmosphere: Option<ViewedEnvironment>,
 }
 
 /// A point on the ground, lifted by [`GROUND_OFFSET_M`].
@@ -46,12 +49,31 @@ impl Environment {
         planet: PlanetGeometry,
     ) -> Environment {
         let sun = (light.sun.irradiance.max_element() > 0.0).then_some(light.sun);
+        let atmosphere = (light.sky_model == SkyModel::Atmosphere)
+            .then(|| ViewedEnvironment::new(light, frame.camera_position_m));
         Environment {
             sun,
             sky: light.sky,
             planet,
             ground_albedo: frame.ground_albedo,
+            atmosphere,
         }
+    }
+
+    /// Sun irradiance reaching `p` on a surface facing the sun: through the air with the
+    /// atmosphere (`environment_sun_irradiance`).
+    pub fn sun_irradiance(&self, p: Vec3) -> Vec3 {
+        match (&self.atmosphere, &self.sun) {
+            (Some(a), _) => a.sun_irradiance(p),
+            (None, Some(sun)) => sun.irradiance,
+            (None, None) => Vec3::ZERO,
+        }
+    }
+
+    /// Radiance of the sun's disc seen from `p` along `dir` (zero outside it).
+    pub fn sun_disc_radiance(&self, p: Vec3, dir: Vec3) -> Vec3 {
+        self.sun
+            .map_or(Vec3::ZERO, |sun| sun.radiance_of(self.sun_irradiance(p), dir))
     }
 
     /// Distance to the ground along the ray, infinite without a ground or when it is missed.
@@ -72,17 +94,26 @@ impl Environment {
         }
     }
 
-    /// Sky radiance arriving from `dir` (the sun disc excluded).
+    /// Sky radiance arriving from `dir` (the sun disc excluded), as the camera sees it.
     pub fn sky_radiance(&self, dir: Vec3) -> Vec3 {
-        self.sky.radiance(dir)
+        match &self.atmosphere {
+            Some(a) => a.sky_radiance(dir),
+            None => self.sky.radiance(dir),
+        }
     }
 
-    /// What the eye sees of radiance `radiance` from `distance_m` away through the haze: the
-    /// aerial perspective the GPU compositor applies
-    /// ([`cloudscape::environment::Environment::aerial_perspective`] at full coverage).
-    pub fn through_haze(&self, radiance: Vec3, distance_m: f32) -> Vec3 {
-        let clear = (-self.sky.haze_per_m * distance_m).exp();
-        radiance * clear + self.sky.horizon * (1.0 - clear)
+    /// What the eye sees of radiance `radiance` from `distance_m` away along `dir` through the
+    /// air or haze: the aerial perspective the GPU compositor applies
+    /// ([`ViewedEnvironment::aerial_perspective`] at full coverage; the air here is not shadowed
+    /// by the clouds).
+    pub fn through_haze(&self, radiance: Vec3, dir: Vec3, distance_m: f32) -> Vec3 {
+        match &self.atmosphere {
+            Some(a) => a.aerial_perspective((radiance, 1.0), (dir, distance_m), |_| 1.0),
+            None => {
+                let clear = (-self.sky.haze_per_m * distance_m).exp();
+                radiance * clear + self.sky.horizon * (1.0 - clear)
+            }
+        }
     }
 
     /// A direction toward the sky for next-event estimation at `p`: uniform over the hemisphere

@@ -98,11 +98,10 @@ impl<M: Medium> PathTracer<M> {
                 ground_m,
             ),
             None => {
-                let sun = env.sun.map_or(Vec3::ZERO, |s| s.radiance(dir));
-                return env.sky_radiance(dir) + sun;
+                return env.sky_radiance(dir) + env.sun_disc_radiance(origin, dir);
             }
         };
-        env.through_haze(self.path_radiance(vertex, rng), distance_m)
+        env.through_haze(self.path_radiance(vertex, rng), dir, distance_m)
     }
 
     /// Radiance leaving `vertex` toward where the path came from.
@@ -134,7 +133,7 @@ impl<M: Medium> PathTracer<M> {
                 None => {
                     let weight = power_heuristic(next.pdf, next.sky_pdf);
                     radiance += throughput * self.environment.sky_radiance(next.dir) * weight;
-                    radiance += throughput * self.sun_reached(next.dir, next.pdf);
+                    radiance += throughput * self.sun_reached(origin, next.dir, next.pdf);
                     break;
                 }
             };
@@ -169,18 +168,19 @@ impl<M: Medium> PathTracer<M> {
             Some(pdf) => power_heuristic(pdf, continuation_pdf),
             None => 1.0,
         };
-        sun.irradiance * scattering * (weight * self.visibility(position(vertex), dir, rng))
+        let p = position(vertex);
+        self.environment.sun_irradiance(p) * scattering * (weight * self.visibility(p, dir, rng))
     }
 
-    /// The sun disc's radiance seen by a continuation that left the medium along `dir` (drawn
-    /// with density `pdf`), weighted against the sun's next-event estimate.
-    fn sun_reached(&self, dir: Vec3, pdf: f32) -> Vec3 {
+    /// The sun disc's radiance seen by a continuation that left the medium from `origin` along
+    /// `dir` (drawn with density `pdf`), weighted against the sun's next-event estimate.
+    fn sun_reached(&self, origin: Vec3, dir: Vec3, pdf: f32) -> Vec3 {
         let Some(sun) = self.environment.sun else {
             return Vec3::ZERO;
         };
         match sun_disc_pdf(&sun) {
             Some(light_pdf) if dir.dot(sun.direction) >= sun.cos_radius => {
-                sun.radiance(dir) * power_heuristic(pdf, light_pdf)
+                self.environment.sun_disc_radiance(origin, dir) * power_heuristic(pdf, light_pdf)
             }
             _ => Vec3::ZERO,
         }

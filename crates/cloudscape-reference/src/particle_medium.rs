@@ -112,6 +112,7 @@ impl PathTracer<ParticleMedium> {
                 // The real sun (Bruneton 2017): as directional as the tables resolve, and wide
                 // enough that sun and phase sampling share the forward peak without fireflies.
                 cos_radius: 0.2679f32.to_radians().cos(),
+                limb_darkening: 0.0,
             }),
             sky: black,
             planet: PlanetGeometry {
@@ -119,6 +120,7 @@ impl PathTracer<ParticleMedium> {
                 radius_m: 6_360_000.0,
             },
             ground_albedo: None,
+            atmosphere: None,
         };
         PathTracer {
             volume: TrackedMedium::new(medium, PARTICLE_MAJORANT_CELLS),

@@ -125,6 +125,7 @@ fn sunlit_conservative_slab_conserves_energy() {
         direction: Vec3::Y,
         irradiance: Vec3::ONE,
         cos_radius: 5f32.to_radians().cos(),
+        limb_darkening: 0.0,
     };
     let t = tracer(
         slab(2.0),
@@ -166,6 +167,7 @@ fn seeds_agree_within_variance_and_repeat_exactly() {
         direction: Vec3::new(0.3, 0.6, 0.2).normalize(),
         irradiance: Vec3::splat(5.0),
         cos_radius: 0.2679f32.to_radians().cos(),
+        limb_darkening: 0.0,
     };
     let mut env = environment(two_tone_sky(0.3, 0.4), Some(sun));
     env.ground_albedo = Some(Vec3::splat(0.2));

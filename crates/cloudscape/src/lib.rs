@@ -14,6 +14,7 @@
 //! build for a file type it lacks is an error that names the feature.
 
 pub mod animation;
+pub mod atmosphere;
 pub mod environment;
 pub mod export;
 pub mod field;
@@ -30,6 +31,7 @@ pub mod raymarch;
 pub mod renderer;
 pub mod scene;
 pub mod shader;
+pub mod shadow;
 pub mod sprites;
 pub mod technique;
 pub mod temporal;

@@ -35,7 +35,21 @@ pub const MODULES: &[WgslModule] = &[
     module("hiheight", include_str!("field/hiheight.wgsl")),
     module("phase", include_str!("optics/phase.wgsl")),
     module("frame", include_str!("frame/frame.wgsl")),
+    module("atmosphere", include_str!("atmosphere/atmosphere.wgsl")),
     module("environment", include_str!("environment/environment.wgsl")),
+    module(
+        "atmosphere_march",
+        include_str!("atmosphere/atmosphere_march.wgsl"),
+    ),
+    module(
+        "atmosphere_luts",
+        include_str!("atmosphere/atmosphere_luts.wgsl"),
+    ),
+    module(
+        "atmosphere_aerial",
+        include_str!("atmosphere/atmosphere_aerial.wgsl"),
+    ),
+    module("cloud_shadow", include_str!("shadow/cloud_shadow.wgsl")),
     module("raymarch", include_str!("raymarch/raymarch.wgsl")),
     module("upsample", include_str!("temporal/upsample.wgsl")),
     module("temporal", include_str!("temporal/temporal.wgsl")),
@@ -76,6 +90,9 @@ pub const MODULES: &[WgslModule] = &[
 /// The modules with entry points: every pipeline the crate builds starts from one of these.
 pub const PROGRAMS: &[&str] = &[
     "noise_gen",
+    "atmosphere_luts",
+    "atmosphere_aerial",
+    "cloud_shadow",
     "raymarch",
     "temporal",
     "upsample_still",
@@ -116,6 +133,7 @@ pub fn constants_wgsl() -> String {
     put(format!(
         "const MAX_HIHEIGHT_LEVELS: u32 = {MAX_HIHEIGHT_LEVELS}u;"
     ));
+    atmosphere_constants(&mut put);
     let gradients: Vec<String> = profile::TYPE_GRADIENTS
         .iter()
         .map(|g| format!("vec4<f32>({:?}, {:?}, {:?}, {:?})", g[0], g[1], g[2], g[3]))
@@ -130,6 +148,44 @@ pub fn constants_wgsl() -> String {
         profile::TYPE_BLEND_HALF_WIDTH
     ));
     s
+}
+
+/// The atmosphere's constants (atmosphere::medium, atmosphere::luts) as WGSL `const`s.
+fn atmosphere_constants(put: &mut impl FnMut(String)) {
+    use crate::atmosphere::luts as l;
+    use crate::atmosphere::medium as m;
+    let scalars = [
+        ("RAYLEIGH_SCALE_HEIGHT_M", m::RAYLEIGH_SCALE_HEIGHT_M),
+        ("MIE_SCALE_HEIGHT_M", m::MIE_SCALE_HEIGHT_M),
+        ("OZONE_PEAK_ALTITUDE_M", m::OZONE_PEAK_ALTITUDE_M),
+        ("OZONE_HALF_WIDTH_M", m::OZONE_HALF_WIDTH_M),
+        ("AERIAL_SLICE_M", l::AERIAL_SLICE_M),
+    ];
+    for (name, value) in scalars {
+        put(format!("const ATMOSPHERE_{name}: f32 = {value:?};"));
+    }
+    let counts = [
+        ("AERIAL_SLICES", l::AERIAL_SLICES),
+        ("AERIAL_STEPS_PER_SLICE", l::AERIAL_STEPS_PER_SLICE),
+        ("TRANSMITTANCE_STEPS", l::TRANSMITTANCE_STEPS),
+        ("MULTIPLE_SCATTERING_STEPS", l::MULTIPLE_SCATTERING_STEPS),
+        ("MULTIPLE_SCATTERING_DIRECTIONS", l::MULTIPLE_SCATTERING_DIRECTIONS),
+        ("SKY_VIEW_STEPS", l::SKY_VIEW_STEPS),
+        ("IRRADIANCE_STEPS", l::IRRADIANCE_STEPS),
+        ("IRRADIANCE_DIRECTIONS", l::IRRADIANCE_DIRECTIONS),
+    ];
+    for (name, value) in counts {
+        put(format!("const ATMOSPHERE_{name}: u32 = {value}u;"));
+    }
+    let sizes = [
+        ("TRANSMITTANCE_SIZE", l::TRANSMITTANCE_SIZE),
+        ("MULTIPLE_SCATTERING_SIZE", l::MULTIPLE_SCATTERING_SIZE),
+        ("IRRADIANCE_SIZE", l::IRRADIANCE_SIZE),
+        ("SKY_VIEW_SIZE", l::SKY_VIEW_SIZE),
+    ];
+    for (name, (w, h)) in sizes {
+        put(format!("const ATMOSPHERE_{name} = vec2<u32>({w}u, {h}u);"));
+    }
 }
 
 /// The module named `name`.

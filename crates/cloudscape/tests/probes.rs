@@ -3,7 +3,8 @@
 //! ground, the diffuse transmittance, phase functions, height profiles and tone mapping. Also: a live edit of the field reaches the
 //! GPU without regenerating the noise.
 
-use cloudscape::environment::Environment;
+use cloudscape::environment::{Environment, ViewedEnvironment};
+use cloudscape::scene::SkyModel;
 use cloudscape::frame::{DepthConvention, Frame};
 use cloudscape::gpu::GpuContext;
 use cloudscape::optics::{PhaseLobes, diffuse_transmittance};
@@ -16,10 +17,14 @@ use std::path::Path;
 
 const SIZE: UVec2 = UVec2::new(64, 36);
 
-/// A renderer of `scene` whose shared groups hold `frame`.
+/// A renderer of `scene` whose shared groups hold `frame`, with the frame's environment tables
+/// filled.
 fn renderer(ctx: &GpuContext, scene: &Scene, frame: &Frame) -> CloudRenderer {
     let mut clouds = CloudRenderer::new(ctx, scene, Path::new(".")).expect("field");
     clouds.begin_frame(ctx, scene, frame, Reuse::None);
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    clouds.encode_environment(ctx, &mut encoder, None);
+    ctx.queue.submit([encoder.finish()]);
     clouds
 }
 
@@ -191,35 +196,16 @@ fn camera_rays_and_depth_match_the_cpu_in_every_convention() {
 }
 
 #[test]
-fn environment_functions_match_the_cpu() {
+fn analytic_environment_functions_match_the_cpu() {
     let ctx = GpuContext::for_tests();
     let mut scene = Scene::default();
     scene.sky.visibility_m = 20_000.0;
+    scene.sky.model = SkyModel::Gradient;
     let frame = Frame::from_scene(&scene, SIZE);
     let clouds = renderer(&ctx, &scene, &frame);
-    let env = Environment::from_scene(&scene);
-    // Directions around the sun disc's edge as well as all over the sky.
-    let radius = env.sun.cos_radius.acos();
-    let around_sun = |i: u32| {
-        let tilt = glam::Quat::from_axis_angle(
-            direction(i, -1.0).cross(env.sun.direction).normalize(),
-            radius * (0.5 + unit(i, 10)),
-        );
-        tilt * env.sun.direction
-    };
-    let dirs: Vec<Vec3> = (0..300)
-        .map(|i| {
-            if i % 2 == 0 {
-                around_sun(i)
-            } else {
-                direction(i, -0.3)
-            }
-        })
-        .collect();
-    let inputs: Vec<ProbeInput> = dirs
-        .iter()
-        .map(|d| input(d.extend(0.0), Vec4::ZERO))
-        .collect();
+    let env = ViewedEnvironment::new(&Environment::from_scene(&scene), frame.camera_position_m);
+    let sun = env.env.sun;
+    let (dirs, inputs) = sky_directions(sun);
     let disc = gpu(&ctx, &clouds, ProbeFunction::SunDiscRadiance, &inputs);
     let inside = disc.iter().filter(|v| v.x > 0.0).count();
     assert!(
@@ -228,7 +214,7 @@ fn environment_functions_match_the_cpu() {
     );
     let want: Vec<Vec4> = dirs
         .iter()
-        .map(|d| env.sun.radiance(*d).extend(0.0))
+        .map(|d| env.sun_disc_radiance(*d).extend(0.0))
         .collect();
     // At the rim a direction may fall on either side in f32: count disagreements, not values.
     let disagree = disc
@@ -243,7 +229,7 @@ fn environment_functions_match_the_cpu() {
     let sky = gpu(&ctx, &clouds, ProbeFunction::SkyRadiance, &inputs);
     let want: Vec<Vec4> = dirs
         .iter()
-        .map(|d| env.sky.radiance(*d).extend(0.0))
+        .map(|d| env.sky_radiance(*d).extend(0.0))
         .collect();
     assert_close("sky", &sky, &want, 1e-5);
 
@@ -259,7 +245,7 @@ fn environment_functions_match_the_cpu() {
     let want: Vec<Vec4> = hazes
         .iter()
         .map(|h| {
-            env.aerial_perspective(h.a.truncate(), h.a.w, h.b.x)
+            env.aerial_perspective((h.a.truncate(), h.a.w), (Vec3::Y, h.b.x), |_| 1.0)
                 .extend(0.0)
         })
         .collect();
@@ -275,7 +261,7 @@ fn environment_functions_match_the_cpu() {
     assert_close(
         "ground",
         &got,
-        &[env.ground_radiance(albedo).extend(0.0)],
+        &[env.ground_radiance(albedo, Vec3::ZERO).extend(0.0)],
         1e-5,
     );
 
@@ -288,6 +274,98 @@ fn environment_functions_match_the_cpu() {
         .map(|t| Vec4::splat(diffuse_transmittance(t.a.x, frame.cloud_mean_cosine)))
         .collect();
     assert_close("diffuse transmittance", &got, &want, 1e-5);
+}
+
+/// Directions around the sun disc's edge as well as all over the sky, and probe inputs of them.
+fn sky_directions(sun: cloudscape::environment::SunDisc) -> (Vec<Vec3>, Vec<ProbeInput>) {
+    let radius = sun.cos_radius.acos();
+    let around_sun = |i: u32| {
+        let tilt = glam::Quat::from_axis_angle(
+            direction(i, -1.0).cross(sun.direction).normalize(),
+            radius * (0.5 + unit(i, 10)),
+        );
+        tilt * sun.direction
+    };
+    let dirs: Vec<Vec3> = (0..300)
+        .map(|i| {
+            if i % 2 == 0 {
+                around_sun(i)
+            } else {
+                direction(i, -0.3)
+            }
+        })
+        .collect();
+    let inputs = dirs
+        .iter()
+        .map(|d| input(d.extend(0.0), Vec4::ZERO))
+        .collect();
+    (dirs, inputs)
+}
+
+/// Asserts the GPU's values of `f` at `points` (as `a.xyz`) agree with `cpu` within `tolerance`
+/// relative to the largest CPU value.
+fn assert_points(
+    (ctx, clouds): (&GpuContext, &CloudRenderer),
+    f: ProbeFunction,
+    points: &[Vec3],
+    cpu: impl Fn(Vec3) -> Vec3,
+    tolerance: f32,
+) {
+    let inputs: Vec<ProbeInput> = points.iter().map(|p| input(p.extend(0.0), Vec4::ZERO)).collect();
+    let got = gpu(ctx, clouds, f, &inputs);
+    let want: Vec<Vec3> = points.iter().map(|p| cpu(*p)).collect();
+    let scale = want.iter().map(|w| w.max_element()).fold(0.0, f32::max);
+    for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+        let error = (g.truncate() - *w).abs().max_element() / scale;
+        assert!(error <= tolerance, "{f:?} #{i} at {}: GPU {g} vs CPU {w}", points[i]);
+    }
+}
+
+/// The atmosphere's tables, built on the GPU, against the CPU's: sun light at altitude (a low sun,
+/// so the air reddens it), sky irradiance and mean radiance, the sky seen from the camera, the
+/// limb-darkened disc and the aerial perspective at the centres of its slices. The GPU stores the
+/// tables in f16 and samples them with its own filtering: 2 % of the largest value.
+#[test]
+fn atmosphere_functions_match_the_cpu() {
+    let ctx = GpuContext::for_tests();
+    let mut scene = Scene::default();
+    scene.sun.elevation_deg = 8.0;
+    scene.layers.clear();
+    scene.sky.visibility_m = 30_000.0;
+    let frame = Frame::from_scene(&scene, SIZE);
+    let clouds = renderer(&ctx, &scene, &frame);
+    let env = ViewedEnvironment::new(&Environment::from_scene(&scene), frame.camera_position_m);
+    let points: Vec<Vec3> = (0..40)
+        .map(|i| Vec3::new(9000.0 * unit(i, 20) - 4500.0, 12_000.0 * unit(i, 21), 9000.0 * unit(i, 22)))
+        .collect();
+    let probe = (&ctx, &clouds);
+    assert_points(probe, ProbeFunction::SunIrradiance, &points, |p| env.sun_irradiance(p), 0.02);
+    assert_points(probe, ProbeFunction::SkyIrradianceUp, &points, |p| env.sky_irradiance_up(p), 0.02);
+    assert_points(probe, ProbeFunction::SkyMeanRadianceUp, &points, |p| env.sky_mean_radiance_up(p), 0.02);
+    let (dirs, _) = sky_directions(env.env.sun);
+    assert_points(probe, ProbeFunction::SkyRadiance, &dirs, |d| env.sky_radiance(d), 0.02);
+    let disc: Vec<Vec3> = dirs.iter().step_by(2).copied().collect();
+    let limb = |d| env.sun_disc_radiance(d);
+    assert_points(probe, ProbeFunction::SunDiscRadiance, &disc, limb, 0.02);
+
+    let grey = Vec3::splat(0.5);
+    let slices: Vec<(Vec2, f32)> = (0..60)
+        .map(|i| {
+            let texel = Vec2::new((i * 7 % 32) as f32, (i * 13 % 32) as f32) + 0.5;
+            (texel / 32.0, 4000.0 * (1 + i % 32) as f32)
+        })
+        .collect();
+    let inputs: Vec<ProbeInput> = slices
+        .iter()
+        .map(|(uv, d)| input(grey.extend(1.0), Vec4::new(*d, uv.x, uv.y, 0.0)))
+        .collect();
+    let got = gpu(&ctx, &clouds, ProbeFunction::AerialPerspective, &inputs);
+    for (i, ((uv, d), g)) in slices.iter().zip(&got).enumerate() {
+        let (_, dir) = frame.camera_ray(*uv * SIZE.as_vec2());
+        let want = env.aerial_perspective((grey, 1.0), (dir, *d), |_| 1.0);
+        let error = ((g.truncate() - want) / want).abs().max_element();
+        assert!(error < 0.02, "aerial #{i} at {d} m: GPU {g} vs CPU {want}");
+    }
 }
 
 /// A CPU tone-mapping function.

@@ -39,6 +39,7 @@ pub fn environment(sky: SkyRadiance, sun: Option<SunDisc>) -> Environment {
         sky,
         planet: FLAT,
         ground_albedo: None,
+        atmosphere: None,
     }
 }
 

@@ -1,53 +1,143 @@
-#import constants
-// The environment interface (environment/mod.rs): sun, sky and haze, bound at group 2. Techniques
-// and the compositor light only through these functions, so a physical atmosphere can replace this
-// module without touching them. The twin of environment::Environment.
+#import constants atmosphere
+// The environment interface (environment/mod.rs): sun, sky, haze and the clouds' shadows, bound at
+// group 2. Techniques, the compositor and hosts light only through these functions. With
+// sky_model 1 they read the atmosphere's tables (Hillaire 2020); otherwise the analytic gradient
+// or constant sky. The twin of environment::Environment.
+
+struct CloudShadow {
+    centre_m: vec2<f32>,       // world xz of the map's centre (under the viewpoint)
+    half_extent_m: f32,        // the map reaches this far from its centre on the ground plane
+    warp: f32,                 // texel size at the centre over the mean texel size (1: no warp)
+    bottom_y_m: f32,           // world y below which the whole cloud column lies above
+    top_y_m: f32,              // world y above which no cloud lies
+    sun_y: f32,                // sun direction's y, at least SHADOW_MIN_SUN_Y
+    enabled: u32,              // 0: no clouds, the map reads zero
+    cloud_mean_cosine: f32,    // mean cosine g of the cloud droplets' phase function
+    steps_per_checkpoint: u32, // samples of the coarse field between two checkpoints
+    pad: vec2<u32>,
+}
 
 struct Environment {
     sun_direction: vec3<f32>,       // unit vector toward the sun
     sun_cos_angular_radius: f32,    // cosine of the sun disc's angular radius
-    sun_irradiance: vec3<f32>,      // rgb irradiance on a surface facing the sun
-    haze_extinction_per_m: f32,     // extinction of the haze between the eye and what it sees
-    sky_zenith_radiance: vec3<f32>, // rgb radiance straight up
-    sky_gradient_exponent: f32,     // mix(horizon, zenith, mu^exponent)
-    sky_horizon_radiance: vec3<f32>,// rgb radiance at and below the horizon
-    sky_pad: f32,
+    sun_irradiance: vec3<f32>,      // rgb irradiance facing the sun (above the air, atmosphere)
+    haze_extinction_per_m: f32,     // analytic skies: extinction of the haze
+    sky_zenith_radiance: vec3<f32>, // analytic skies: rgb radiance straight up
+    sky_gradient_exponent: f32,     // analytic skies: mix(horizon, zenith, mu^exponent)
+    sky_horizon_radiance: vec3<f32>,// analytic skies: rgb radiance at and below the horizon
+    sky_model: u32,                 // 0: analytic, 1: atmosphere
+    viewpoint_m: vec3<f32>,         // world point the sky and aerial perspective are seen from
+    sun_limb_darkening: f32,        // linear limb-darkening coefficient u of the sun's disc
+    air: Air,
+    shadow: CloudShadow,
 }
 
 @group(2) @binding(0) var<uniform> environment: Environment;
+@group(2) @binding(1) var environment_transmittance: texture_2d<f32>;
+@group(2) @binding(2) var environment_multiple_scattering: texture_2d<f32>;
+@group(2) @binding(3) var environment_irradiance: texture_2d_array<f32>;
+@group(2) @binding(4) var environment_sky_view: texture_2d<f32>;
+@group(2) @binding(5) var environment_aerial_inscatter: texture_3d<f32>;
+@group(2) @binding(6) var environment_aerial_transmittance: texture_3d<f32>;
+@group(2) @binding(7) var environment_cloud_shadow: texture_2d_array<f32>;
+@group(2) @binding(8) var environment_linear: sampler;
 
 // Unit vector toward the sun.
 fn environment_sun_direction() -> vec3<f32> {
     return environment.sun_direction;
 }
 
-// Sun irradiance reaching world point p (on a surface facing the sun).
-fn environment_sun_irradiance(p: vec3<f32>) -> vec3<f32> {
-    return environment.sun_irradiance;
+// Radius and unit up of world point p in atmosphere space.
+fn environment_radius_up(p: vec3<f32>) -> vec4<f32> {
+    let q = atmosphere_position(environment.air, p);
+    let r = length(q);
+    return vec4<f32>(r, q / r);
 }
 
-// Radiance of the sun's disc seen in direction d: SunDisc::radiance, E / (2 pi (1 - cos r)) inside.
+// Transmittance of the air from radius r toward the sun at cosine mu_s, zero once the planet
+// hides the disc: SkyTables::sun_transmittance (Bruneton 2017, GetTransmittanceToSun).
+fn environment_table_sun_transmittance(r: f32, mu_s: f32) -> vec3<f32> {
+    let air = environment.air;
+    let sin_horizon = air.bottom_radius_m / max(r, air.bottom_radius_m);
+    let cos_horizon = -sqrt(max(1.0 - sin_horizon * sin_horizon, 0.0));
+    let edge = sin_horizon * air.sun_angular_radius_rad;
+    var visible = select(0.0, 1.0, mu_s >= cos_horizon);
+    if edge > 0.0 {
+        visible = smoothstep(-edge, edge, mu_s - cos_horizon);
+    }
+    let uv = atmosphere_transmittance_uv(air, r, mu_s);
+    return textureSampleLevel(environment_transmittance, environment_linear, uv, 0.0).rgb * visible;
+}
+
+// Psi_ms at radius r and sun cosine mu_s: SkyTables::multiple_scattering.
+fn environment_table_multiple_scattering(r: f32, mu_s: f32) -> vec3<f32> {
+    let uv = atmosphere_sun_table_uv(environment.air, r, mu_s, vec2<f32>(ATMOSPHERE_MULTIPLE_SCATTERING_SIZE));
+    return textureSampleLevel(environment_multiple_scattering, environment_linear, uv, 0.0).rgb;
+}
+
+// Transmittance of the air from p toward the sun (1 for the analytic skies).
+fn environment_sun_transmittance(p: vec3<f32>) -> vec3<f32> {
+    if environment.sky_model != 1u {
+        return vec3<f32>(1.0);
+    }
+    let ru = environment_radius_up(p);
+    return environment_table_sun_transmittance(ru.x, dot(ru.yzw, environment.sun_direction));
+}
+
+// Sun irradiance reaching world point p (on a surface facing the sun): Environment::sun_irradiance.
+fn environment_sun_irradiance(p: vec3<f32>) -> vec3<f32> {
+    return environment.sun_irradiance * environment_sun_transmittance(p);
+}
+
+// Radiance of the sun's disc seen from the viewpoint in direction d, limb-darkened by the linear
+// law I(mu) / I(1) = 1 - u (1 - mu) and normalised so the disc integrates to the irradiance:
+// SunDisc::radiance.
 fn environment_sun_disc_radiance(d: vec3<f32>) -> vec3<f32> {
-    let solid_angle = 2.0 * PI * (1.0 - environment.sun_cos_angular_radius);
-    if solid_angle <= 0.0 || dot(d, environment.sun_direction) < environment.sun_cos_angular_radius {
+    let one_minus_cos_radius = 1.0 - environment.sun_cos_angular_radius;
+    let cos_angle = dot(d, environment.sun_direction);
+    if one_minus_cos_radius <= 0.0 || cos_angle < environment.sun_cos_angular_radius {
         return vec3<f32>(0.0);
     }
-    return environment.sun_irradiance / solid_angle;
+    let u = environment.sun_limb_darkening;
+    let mu = sqrt(clamp(1.0 - (1.0 - cos_angle) / one_minus_cos_radius, 0.0, 1.0));
+    let limb = (1.0 - u * (1.0 - mu)) / (1.0 - u / 3.0);
+    return environment_sun_irradiance(environment.viewpoint_m) * limb / (2.0 * PI * one_minus_cos_radius);
 }
 
-// Sky radiance from direction d: SkyRadiance::radiance.
+// Sky radiance arriving at the viewpoint from direction d (the disc excluded): the sky-view table
+// (atmosphere) or SkyRadiance::radiance.
 fn environment_sky_radiance(d: vec3<f32>) -> vec3<f32> {
+    if environment.sky_model == 1u {
+        let ru = environment_radius_up(environment.viewpoint_m);
+        let angles = atmosphere_local_angles(ru.yzw, d, environment.sun_direction);
+        let uv = atmosphere_sky_view_uv(environment.air, ru.x, angles);
+        return environment.sun_irradiance * textureSampleLevel(environment_sky_view, environment_linear, uv, 0.0).rgb;
+    }
     let mu = max(d.y, 0.0);
     return mix(environment.sky_horizon_radiance, environment.sky_zenith_radiance, pow(mu, environment.sky_gradient_exponent));
 }
 
-// Mean sky radiance over the upper hemisphere at p: SkyRadiance::mean_radiance_up.
+// Layer `layer` of the irradiance table at p: 0 the irradiance on an upward surface, 1 the mean
+// radiance over the hemisphere above it, for the scene's sun.
+fn environment_table_irradiance(p: vec3<f32>, layer: i32) -> vec3<f32> {
+    let ru = environment_radius_up(p);
+    let uv = atmosphere_sun_table_uv(environment.air, ru.x, dot(ru.yzw, environment.sun_direction), vec2<f32>(ATMOSPHERE_IRRADIANCE_SIZE));
+    return environment.sun_irradiance * textureSampleLevel(environment_irradiance, environment_linear, uv, layer, 0.0).rgb;
+}
+
+// Mean sky radiance over the upper hemisphere at p: Environment::sky_mean_radiance_up.
 fn environment_sky_mean_radiance_up(p: vec3<f32>) -> vec3<f32> {
+    if environment.sky_model == 1u {
+        return environment_table_irradiance(p, 1);
+    }
     return mix(environment.sky_horizon_radiance, environment.sky_zenith_radiance, 1.0 / (1.0 + environment.sky_gradient_exponent));
 }
 
-// Sky irradiance on an upward-facing surface at p: SkyRadiance::irradiance_up.
+// Sky irradiance on an upward-facing surface at p: Environment::sky_irradiance_up.
 fn environment_sky_irradiance_up(p: vec3<f32>) -> vec3<f32> {
+    if environment.sky_model == 1u {
+        return environment_table_irradiance(p, 0);
+    }
     return PI * mix(environment.sky_horizon_radiance, environment.sky_zenith_radiance, 2.0 / (2.0 + environment.sky_gradient_exponent));
 }
 
@@ -58,10 +148,91 @@ fn environment_ground_radiance(albedo: vec3<f32>, p: vec3<f32>) -> vec3<f32> {
     return albedo / PI * (sun + environment_sky_irradiance_up(p));
 }
 
-// What the eye sees of `radiance`, scattered by something covering fraction `coverage` of the pixel
-// `distance_m` away, through the haze: it fades toward the horizon radiance by exp(-haze distance)
-// (Koschmieder 1924). Environment::aerial_perspective; applied once, in compositing.
-fn environment_aerial_perspective(radiance: vec3<f32>, coverage: f32, distance_m: f32) -> vec3<f32> {
-    let clear = exp(-environment.haze_extinction_per_m * distance_m);
-    return radiance * clear + environment.sky_horizon_radiance * coverage * (1.0 - clear);
+// What the eye sees of `radiance`, scattered by something covering fraction `coverage` of the
+// pixel at screen position `uv` (0..1, y down) and `distance_m` away: through the atmosphere's
+// aerial-perspective volume (32 slices of 4 km; below the first slice, a linear fade from the eye),
+// or the analytic skies' haze, fading toward the horizon radiance by exp(-haze distance)
+// (Koschmieder 1924). Applied once, in compositing: Environment::aerial_perspective.
+fn environment_aerial_perspective(radiance: vec3<f32>, coverage: f32, uv: vec2<f32>, distance_m: f32) -> vec3<f32> {
+    if environment.sky_model != 1u {
+        let clear = exp(-environment.haze_extinction_per_m * distance_m);
+        return radiance * clear + environment.sky_horizon_radiance * coverage * (1.0 - clear);
+    }
+    let slices = distance_m / ATMOSPHERE_AERIAL_SLICE_M;
+    let w = (slices - 0.5) / f32(ATMOSPHERE_AERIAL_SLICES);
+    let uvw = vec3<f32>(uv, clamp(w, 0.0, 1.0));
+    var inscatter = textureSampleLevel(environment_aerial_inscatter, environment_linear, uvw, 0.0).rgb;
+    var transmittance = textureSampleLevel(environment_aerial_transmittance, environment_linear, uvw, 0.0).rgb;
+    let near = clamp(slices, 0.0, 1.0);
+    inscatter *= near;
+    transmittance = mix(vec3<f32>(1.0), transmittance, near);
+    return radiance * transmittance + environment.sun_irradiance * inscatter * coverage;
+}
+
+// Texel coordinate in [-1, 1] of ground-plane offset x (in half extents, -1..1) in the warped
+// cloud-shadow map: the inverse of x = s (k + (1 - k) |s|), k the warp (CloudShadowMap::texel_of).
+fn environment_shadow_coord(x: f32) -> f32 {
+    let k = environment.shadow.warp;
+    let a = abs(x);
+    var s = a;
+    if k < 1.0 {
+        s = (-k + sqrt(k * k + 4.0 * (1.0 - k) * a)) / (2.0 * (1.0 - k));
+    }
+    return sign(x) * s;
+}
+
+// Ground-plane offset (in half extents) of texel coordinate s: x = s (k + (1 - k) |s|), fine texels
+// near the viewpoint and coarse ones far away (CloudShadowMap::offset_of).
+fn environment_shadow_offset(s: f32) -> f32 {
+    let k = environment.shadow.warp;
+    return s * (k + (1.0 - k) * abs(s));
+}
+
+// Cloud optical depth above height y from the map's four checkpoints (rgba at bottom + 0, 1/4, 1/2
+// and 3/4 of the span; zero at its top), read in `layer` at ground-plane point g: linear between
+// checkpoints (CloudShadowMap::optical_depth).
+fn environment_shadow_read(g: vec2<f32>, y: f32, layer: i32) -> f32 {
+    let s = environment.shadow;
+    if s.enabled == 0u || y >= s.top_y_m {
+        return 0.0;
+    }
+    let x = (g - s.centre_m) / s.half_extent_m;
+    if any(abs(x) > vec2<f32>(1.0)) {
+        return 0.0;
+    }
+    let coord = vec2<f32>(environment_shadow_coord(x.x), environment_shadow_coord(x.y));
+    let checkpoints = textureSampleLevel(environment_cloud_shadow, environment_linear, coord * 0.5 + 0.5, layer, 0.0);
+    let f = clamp((y - s.bottom_y_m) / (s.top_y_m - s.bottom_y_m), 0.0, 1.0) * 4.0;
+    var values = array<f32, 5>(checkpoints.x, checkpoints.y, checkpoints.z, checkpoints.w, 0.0);
+    let i = min(u32(f), 3u);
+    return mix(values[i], values[i + 1u], f - f32(i));
+}
+
+// Optical depth of the clouds between world point p and the sun, from the shared light-space map
+// (its ground-plane projection along the sun): for hosts' geometry, the ground and the air.
+fn environment_cloud_sun_optical_depth(p: vec3<f32>) -> f32 {
+    let s = environment.shadow;
+    let g = p.xz - environment.sun_direction.xz * (p.y / s.sun_y);
+    return environment_shadow_read(g, p.y, 0);
+}
+
+// Optical depth of the clouds straight above world point p, from the map: what dims the sky's
+// light on p.
+fn environment_cloud_sky_optical_depth(p: vec3<f32>) -> f32 {
+    return environment_shadow_read(p.xz, p.y, 1);
+}
+
+// Transmittance of the direct sun beam between world point p and the sun through the clouds,
+// exp(-tau) (Beer-Lambert) from the shared map: the shadow a host's geometry receives.
+fn environment_cloud_sun_transmittance(p: vec3<f32>) -> f32 {
+    return exp(-environment_cloud_sun_optical_depth(p));
+}
+
+// The share of the sun's light that reaches world point p through the clouds, direct beam and the
+// light they scatter forward (most of it within a few degrees of the sun): the Eddington diffuse
+// transmittance 1 / (1 + 3/4 (1 - g) tau) of the map's optical depth toward the sun (as
+// frame_diffuse_transmittance; optics::diffuse_transmittance). What the ground and the air see.
+fn environment_cloud_sun_visibility(p: vec3<f32>) -> f32 {
+    let tau = environment_cloud_sun_optical_depth(p);
+    return 1.0 / (1.0 + 0.75 * (1.0 - environment.shadow.cloud_mean_cosine) * tau);
 }

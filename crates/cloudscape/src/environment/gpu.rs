@@ -1,11 +1,92 @@
-//! The environment on the GPU: one uniform in a bind group of its own.
+//! The environment on the GPU: its uniform, the atmosphere's tables and the clouds' shadow map in
+//! one bind group ([`crate::shader::ENVIRONMENT_GROUP`]), as `environment.wgsl` declares them.
 
-use super::Environment;
-use crate::gpu::uniform::UniformGroup;
+use super::{Environment, SkyModel};
+use crate::atmosphere::Air;
+use crate::atmosphere::luts::{
+    AERIAL_SLICES, IRRADIANCE_SIZE, MULTIPLE_SCATTERING_SIZE, SKY_VIEW_SIZE, TRANSMITTANCE_SIZE,
+};
+use crate::gpu::GpuContext;
+use crate::gpu::pipeline::{UNIFORM, bind_group, bind_group_layout, float_texture, uniform_buffer};
+use crate::shadow::ShadowParams;
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-/// GPU layout of an [`Environment`]: the `Environment` struct of `environment.wgsl`.
+/// Columns and rows of the aerial-perspective volume across the view (Hillaire 2020: 32 x 32).
+pub const AERIAL_SIZE: (u32, u32) = (32, 32);
+/// Format of every table: filterable everywhere, and storage-writable.
+pub const TABLE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// GPU layout of [`Air`]: the `Air` struct of `atmosphere.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct AirUniform {
+    rayleigh_scattering_per_m: Vec3,
+    bottom_radius_m: f32,
+    ozone_absorption_per_m: Vec3,
+    top_radius_m: f32,
+    ground_albedo: Vec3,
+    mie_scattering_per_m: f32,
+    mie_extinction_per_m: f32,
+    mie_g: f32,
+    sun_angular_radius_rad: f32,
+    flat_world: u32,
+}
+
+impl AirUniform {
+    /// The uniform of `air`.
+    pub fn new(air: &Air) -> AirUniform {
+        AirUniform {
+            rayleigh_scattering_per_m: air.rayleigh_scattering_per_m,
+            bottom_radius_m: air.bottom_radius_m,
+            ozone_absorption_per_m: air.ozone_absorption_per_m,
+            top_radius_m: air.top_radius_m,
+            ground_albedo: air.ground_albedo,
+            mie_scattering_per_m: air.mie_scattering_per_m,
+            mie_extinction_per_m: air.mie_extinction_per_m,
+            mie_g: air.mie_g,
+            sun_angular_radius_rad: air.sun_angular_radius_rad,
+            flat_world: u32::from(air.flat_world),
+        }
+    }
+}
+
+/// GPU layout of [`ShadowParams`]: the `CloudShadow` struct of `environment.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct CloudShadowUniform {
+    centre_m: Vec2,
+    half_extent_m: f32,
+    warp: f32,
+    bottom_y_m: f32,
+    top_y_m: f32,
+    sun_y: f32,
+    enabled: u32,
+    cloud_mean_cosine: f32,
+    steps_per_checkpoint: u32,
+    pad: [u32; 2],
+}
+
+impl CloudShadowUniform {
+    /// The uniform of `params`.
+    pub fn new(params: &ShadowParams) -> CloudShadowUniform {
+        CloudShadowUniform {
+            centre_m: params.centre_m,
+            half_extent_m: params.half_extent_m,
+            warp: params.warp,
+            bottom_y_m: params.bottom_y_m,
+            top_y_m: params.top_y_m,
+            sun_y: params.sun_y,
+            enabled: u32::from(params.enabled),
+            cloud_mean_cosine: params.cloud_mean_cosine,
+            steps_per_checkpoint: params.steps_per_checkpoint,
+            pad: [0; 2],
+        }
+    }
+}
+
+/// GPU layout of an [`Environment`] seen from one viewpoint: the `Environment` struct of
+/// `environment.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct EnvironmentUniform {
@@ -16,12 +97,17 @@ pub struct EnvironmentUniform {
     sky_zenith_radiance: Vec3,
     sky_gradient_exponent: f32,
     sky_horizon_radiance: Vec3,
-    sky_pad: f32,
+    sky_model: u32,
+    viewpoint_m: Vec3,
+    sun_limb_darkening: f32,
+    air: AirUniform,
+    shadow: CloudShadowUniform,
 }
 
 impl EnvironmentUniform {
-    /// The uniform of `env`.
-    pub fn new(env: &Environment) -> EnvironmentUniform {
+    /// The uniform of `env` seen from world point `viewpoint_m`, with the clouds' shadow map
+    /// `shadow`.
+    pub fn new(env: &Environment, viewpoint_m: Vec3, shadow: &ShadowParams) -> EnvironmentUniform {
         EnvironmentUniform {
             sun_direction: env.sun.direction,
             sun_cos_angular_radius: env.sun.cos_radius,
@@ -30,14 +116,286 @@ impl EnvironmentUniform {
             sky_zenith_radiance: env.sky.zenith,
             sky_gradient_exponent: env.sky.exponent,
             sky_horizon_radiance: env.sky.horizon,
-            sky_pad: 0.0,
+            sky_model: u32::from(env.sky_model == SkyModel::Atmosphere),
+            viewpoint_m,
+            sun_limb_darkening: env.sun.limb_darkening,
+            air: AirUniform::new(&env.air),
+            shadow: CloudShadowUniform::new(shadow),
         }
     }
 }
 
-/// The environment's uniform buffer and bind group ([`crate::shader::ENVIRONMENT_GROUP`]):
-/// `EnvironmentGpu::new(ctx, "environment")`, then `write(ctx, &EnvironmentUniform::new(&env))`.
-pub type EnvironmentGpu = UniformGroup<EnvironmentUniform>;
+/// The environment's tables, each written by one pass; the bind group a pass binds while it
+/// writes one holds a stand-in for it (a texture cannot be read and written in one pass).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnvironmentTable {
+    /// Transmittance to the top of the air (binding 1).
+    Transmittance,
+    /// Hillaire's multiple-scattering transfer (binding 2).
+    MultipleScattering,
+    /// Sky irradiance and mean radiance (binding 3).
+    Irradiance,
+    /// The sky seen from the viewpoint (binding 4).
+    SkyView,
+    /// Aerial-perspective in-scattering and transmittance (bindings 5 and 6).
+    Aerial,
+    /// The clouds' light-space optical depth (binding 7).
+    CloudShadow,
+}
+
+impl EnvironmentTable {
+    /// Every table, in binding order.
+    pub const ALL: [EnvironmentTable; 6] = [
+        EnvironmentTable::Transmittance,
+        EnvironmentTable::MultipleScattering,
+        EnvironmentTable::Irradiance,
+        EnvironmentTable::SkyView,
+        EnvironmentTable::Aerial,
+        EnvironmentTable::CloudShadow,
+    ];
+
+    /// Bindings of the texture (or textures) of this table.
+    fn bindings(self) -> &'static [usize] {
+        match self {
+            EnvironmentTable::Transmittance => &[1],
+            EnvironmentTable::MultipleScattering => &[2],
+            EnvironmentTable::Irradiance => &[3],
+            EnvironmentTable::SkyView => &[4],
+            EnvironmentTable::Aerial => &[5, 6],
+            EnvironmentTable::CloudShadow => &[7],
+        }
+    }
+}
+
+/// One table texture: its size, layers (or depth) and dimension.
+struct TableShape {
+    label: &'static str,
+    size: (u32, u32, u32),
+    dimension: wgpu::TextureViewDimension,
+}
+
+/// The shapes of bindings 1-7 for a shadow map of `shadow_texels` per side.
+fn shapes(shadow_texels: u32) -> [TableShape; 7] {
+    use wgpu::TextureViewDimension::{D2, D2Array, D3};
+    let shape = |label, (w, h): (u32, u32), layers, dimension| TableShape {
+        label,
+        size: (w, h, layers),
+        dimension,
+    };
+    [
+        shape("transmittance table", TRANSMITTANCE_SIZE, 1, D2),
+        shape("multiple scattering table", MULTIPLE_SCATTERING_SIZE, 1, D2),
+        shape("sky irradiance table", IRRADIANCE_SIZE, 2, D2Array),
+        shape("sky view table", SKY_VIEW_SIZE, 1, D2),
+        shape("aerial inscattering", AERIAL_SIZE, AERIAL_SLICES, D3),
+        shape("aerial transmittance", AERIAL_SIZE, AERIAL_SLICES, D3),
+        shape("cloud shadow map", (shadow_texels, shadow_texels), 2, D2Array),
+    ]
+}
+
+fn make_texture(ctx: &GpuContext, shape: &TableShape, stand_in: bool) -> wgpu::Texture {
+    let (w, h, d) = if stand_in { (1, 1, shape.size.2.min(2)) } else { shape.size };
+    let dimension = match shape.dimension {
+        wgpu::TextureViewDimension::D3 => wgpu::TextureDimension::D3,
+        _ => wgpu::TextureDimension::D2,
+    };
+    let depth = if stand_in && dimension == wgpu::TextureDimension::D3 { 1 } else { d };
+    ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(shape.label),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: depth,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension,
+        format: TABLE_FORMAT,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+fn whole_view(texture: &wgpu::Texture, dimension: wgpu::TextureViewDimension) -> wgpu::TextureView {
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(dimension),
+        ..Default::default()
+    })
+}
+
+/// The environment's uniform buffer, tables and bind groups ([`crate::shader::ENVIRONMENT_GROUP`]):
+/// `EnvironmentGpu::new(ctx, 256)`, then `write(ctx, &EnvironmentUniform::new(..))` each frame;
+/// [`crate::environment::EnvironmentPasses`] fills the tables.
+pub struct EnvironmentGpu {
+    buffer: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    textures: Vec<wgpu::Texture>,
+    views: Vec<wgpu::TextureView>,
+    stand_ins: Vec<wgpu::TextureView>,
+    bind_group: Option<wgpu::BindGroup>,
+    writing: Vec<wgpu::BindGroup>,
+    outputs: Vec<Vec<wgpu::TextureView>>,
+    shadow_texels: u32,
+    generation: u64,
+}
+
+impl EnvironmentGpu {
+    /// Makes the buffer (zeroed), the tables (a shadow map of `shadow_texels` per side) and the
+    /// bind groups.
+    pub fn new(ctx: &GpuContext, shadow_texels: u32) -> EnvironmentGpu {
+        let buffer = uniform_buffer(ctx, "environment", size_of::<EnvironmentUniform>() as u64);
+        let mut types = vec![UNIFORM];
+        types.extend(shapes(1).iter().map(|s| float_texture(s.dimension)));
+        types.push(wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering));
+        let layout = bind_group_layout(&ctx.device, "environment", &types);
+        let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("environment tables"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let stand_ins = shapes(1)
+            .iter()
+            .map(|s| whole_view(&make_texture(ctx, s, true), s.dimension))
+            .collect();
+        let mut gpu = EnvironmentGpu {
+            buffer,
+            layout,
+            sampler,
+            textures: Vec::new(),
+            views: Vec::new(),
+            stand_ins,
+            bind_group: None,
+            writing: Vec::new(),
+            outputs: Vec::new(),
+            shadow_texels: 0,
+            generation: 0,
+        };
+        gpu.resize_shadow_map(ctx, shadow_texels);
+        gpu
+    }
+
+    /// Remakes the tables and bind groups for a shadow map of `shadow_texels` per side (nothing
+    /// when it already has that size). The tables' contents are lost: fill them again.
+    pub fn resize_shadow_map(&mut self, ctx: &GpuContext, shadow_texels: u32) {
+        if shadow_texels == self.shadow_texels {
+            return;
+        }
+        let shapes = shapes(shadow_texels);
+        self.textures = shapes.iter().map(|s| make_texture(ctx, s, false)).collect();
+        self.views = self
+            .textures
+            .iter()
+            .zip(&shapes)
+            .map(|(t, s)| whole_view(t, s.dimension))
+            .collect();
+        self.bind_group = Some(self.group(ctx, None));
+        self.writing = EnvironmentTable::ALL
+            .iter()
+            .map(|t| self.group(ctx, Some(*t)))
+            .collect();
+        self.outputs = EnvironmentTable::ALL
+            .iter()
+            .map(|t| self.storage_views(*t))
+            .collect();
+        self.shadow_texels = shadow_texels;
+        self.generation += 1;
+    }
+
+    /// The views a pass writes `table` through: the whole texture, or one view per layer of an
+    /// array (irradiance and mean radiance; the sun's and the sky's columns), or both volumes of
+    /// the aerial perspective.
+    fn storage_views(&self, table: EnvironmentTable) -> Vec<wgpu::TextureView> {
+        let texture = &self.textures[table.bindings()[0] - 1];
+        match table {
+            EnvironmentTable::Irradiance | EnvironmentTable::CloudShadow => (0..2)
+                .map(|layer| {
+                    texture.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::D2),
+                        base_array_layer: layer,
+                        array_layer_count: Some(1),
+                        ..Default::default()
+                    })
+                })
+                .collect(),
+            EnvironmentTable::Aerial => vec![self.views[4].clone(), self.views[5].clone()],
+            _ => vec![texture.create_view(&Default::default())],
+        }
+    }
+
+    /// The storage views of `table` ([`EnvironmentTable`]'s outputs, in binding order).
+    pub fn output_views(&self, table: EnvironmentTable) -> &[wgpu::TextureView] {
+        &self.outputs[Self::index(table)]
+    }
+
+    /// Counts the times the tables were remade: a pass's bind groups of
+    /// [`EnvironmentGpu::output_views`] are stale when it changed.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    fn index(table: EnvironmentTable) -> usize {
+        EnvironmentTable::ALL
+            .iter()
+            .position(|t| *t == table)
+            .expect("every table is in ALL")
+    }
+
+    /// The bind group with the stand-ins in place of `written`'s textures.
+    fn group(&self, ctx: &GpuContext, written: Option<EnvironmentTable>) -> wgpu::BindGroup {
+        let replaced = written.map_or(&[][..], EnvironmentTable::bindings);
+        let mut resources = vec![self.buffer.as_entire_binding()];
+        for (i, view) in self.views.iter().enumerate() {
+            let view = if replaced.contains(&(i + 1)) {
+                &self.stand_ins[i]
+            } else {
+                view
+            };
+            resources.push(wgpu::BindingResource::TextureView(view));
+        }
+        resources.push(wgpu::BindingResource::Sampler(&self.sampler));
+        bind_group(&ctx.device, &self.layout, &resources)
+    }
+
+    /// Uploads `value` for the next submitted work.
+    pub fn write(&self, ctx: &GpuContext, value: &EnvironmentUniform) {
+        ctx.queue
+            .write_buffer(&self.buffer, 0, bytemuck::bytes_of(value));
+    }
+
+    /// The bind group layout, for pipeline layouts.
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// The bind group with every table.
+    pub fn bind_group(&self) -> &wgpu::BindGroup {
+        self.bind_group.as_ref().expect("made by new")
+    }
+
+    /// The bind group for the pass that writes `table`: a stand-in in its place.
+    pub fn bind_group_writing(&self, table: EnvironmentTable) -> &wgpu::BindGroup {
+        &self.writing[Self::index(table)]
+    }
+
+    /// The texture (the first, for the aerial perspective's pair) of `table`.
+    pub fn texture(&self, table: EnvironmentTable) -> &wgpu::Texture {
+        &self.textures[table.bindings()[0] - 1]
+    }
+
+    /// The aerial perspective's transmittance volume.
+    pub fn aerial_transmittance(&self) -> &wgpu::Texture {
+        &self.textures[5]
+    }
+
+    /// Texels per side of the shadow map.
+    pub fn shadow_texels(&self) -> u32 {
+        self.shadow_texels
+    }
+}
 
 #[cfg(test)]
 mod tests {
@@ -57,7 +415,43 @@ mod tests {
                 sky_zenith_radiance,
                 sky_gradient_exponent,
                 sky_horizon_radiance,
-                sky_pad,
+                sky_model,
+                viewpoint_m,
+                sun_limb_darkening,
+                air,
+                shadow,
+            }
+        );
+        assert_wgsl_layout!(
+            "probe",
+            "Air",
+            AirUniform {
+                rayleigh_scattering_per_m,
+                bottom_radius_m,
+                ozone_absorption_per_m,
+                top_radius_m,
+                ground_albedo,
+                mie_scattering_per_m,
+                mie_extinction_per_m,
+                mie_g,
+                sun_angular_radius_rad,
+                flat_world,
+            }
+        );
+        assert_wgsl_layout!(
+            "probe",
+            "CloudShadow",
+            CloudShadowUniform {
+                centre_m,
+                half_extent_m,
+                warp,
+                bottom_y_m,
+                top_y_m,
+                sun_y,
+                enabled,
+                cloud_mean_cosine,
+                steps_per_checkpoint,
+                pad,
             }
         );
     }

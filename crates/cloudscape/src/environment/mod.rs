@@ -1,27 +1,48 @@
-//! The light around the clouds: the sun, the sky and the haze between the eye and what it sees.
+//! The light around the clouds: the sun, the sky, the haze between the eye and what it sees, and
+//! the clouds' shadows on everything below them.
 //!
-//! This is the environment interface every technique and the compositor light with. On the GPU it
-//! is bind group [`crate::shader::ENVIRONMENT_GROUP`] and the functions of `environment.wgsl`:
+//! This is the environment interface every technique, the compositor and a host light with. On
+//! the GPU it is bind group [`crate::shader::ENVIRONMENT_GROUP`] ([`EnvironmentGpu`]) and the
+//! functions of `environment.wgsl`:
 //!
-//! - `environment_sun_direction()`, `environment_sun_irradiance(p)`: the sun as it reaches `p`;
-//! - `environment_sun_disc_radiance(dir)`: the disc seen by the eye;
+//! - `environment_sun_direction()`, `environment_sun_irradiance(p)`: the sun as it reaches `p`
+//!   (through the air: red at sunset);
+//! - `environment_sun_disc_radiance(dir)`: the limb-darkened disc seen by the eye;
 //! - `environment_sky_radiance(dir)`, `environment_sky_mean_radiance_up(p)`,
 //!   `environment_sky_irradiance_up(p)`: the sky;
-//! - `environment_aerial_perspective(radiance, coverage, distance_m)`: the haze, applied once, in
-//!   compositing.
+//! - `environment_aerial_perspective(radiance, coverage, uv, distance_m)`: the haze, applied once,
+//!   in compositing;
+//! - `environment_cloud_sun_optical_depth(p)`, `environment_cloud_sky_optical_depth(p)`,
+//!   `environment_cloud_sun_visibility(p)`, `environment_cloud_sun_transmittance(p)`: the clouds'
+//!   shared shadow map ([`crate::shadow`]), for the ground, the air and a host's geometry.
 //!
-//! A physical atmosphere replaces this module's WGSL and uniform behind the same functions, without
-//! touching a technique. [`Environment`] is the CPU twin: the path tracer lights with it, and probe
-//! tests hold the GPU functions against it.
+//! `sky.model = "atmosphere"` (the default) puts Hillaire 2020's atmosphere ([`crate::atmosphere`])
+//! behind these functions; `gradient` and `constant` keep the analytic skies. [`EnvironmentPasses`]
+//! fills the tables each frame. [`Environment`] and [`ViewedEnvironment`] are the CPU twins: the
+//! path tracer lights with them, and probe tests hold the GPU functions against them.
 
 mod gpu;
+mod passes;
+mod table_pass;
 
-pub use gpu::{EnvironmentGpu, EnvironmentUniform};
+pub use gpu::{
+    AERIAL_SIZE, AirUniform, CloudShadowUniform, EnvironmentGpu, EnvironmentTable,
+    EnvironmentUniform, TABLE_FORMAT,
+};
+pub use passes::EnvironmentPasses;
+pub use table_pass::TablePass;
 
+use crate::atmosphere::{Air, Atmosphere, SkyView};
 use crate::frame::direction_from_angles_deg;
-use crate::scene::{Scene, SkyModel};
+pub use crate::scene::SkyModel;
+use crate::scene::Scene;
 use glam::Vec3;
 use std::f32::consts::{PI, TAU};
+use std::sync::Arc;
+
+/// Linear limb-darkening coefficient of the sun's disc in the visible: `I(mu) / I(1) = 1 - u (1 -
+/// mu)`, u about 0.6 at 550 nm (Pierce & Slaughter 1977, "Solar limb darkening", Solar Physics 51).
+pub const SUN_LIMB_DARKENING: f32 = 0.6;
 
 /// `-ln(0.02)`: visibility is the distance at which haze leaves 2 % contrast, so the haze extinction
 /// is 3.912 / visibility (Koschmieder 1924).
@@ -52,7 +73,7 @@ impl SkyRadiance {
                 exponent: 1.0,
                 haze_per_m,
             },
-            SkyModel::Gradient => SkyRadiance {
+            SkyModel::Gradient | SkyModel::Atmosphere => SkyRadiance {
                 zenith: s.zenith_radiance.into(),
                 horizon: s.horizon_radiance.into(),
                 exponent: s.gradient_exponent,
@@ -78,38 +99,58 @@ impl SkyRadiance {
     }
 }
 
-/// The sun, a uniform disc.
+/// The sun, a limb-darkened disc.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SunDisc {
     /// Unit vector toward the centre of the disc.
     pub direction: Vec3,
-    /// Irradiance on a surface facing the sun (the disc's radiance integrated over it).
+    /// Irradiance on a surface facing the sun (the disc's radiance integrated over it); above the
+    /// air with the atmosphere.
     pub irradiance: Vec3,
     /// Cosine of the angular radius.
     pub cos_radius: f32,
+    /// Linear limb-darkening coefficient `u` (0: a uniform disc).
+    pub limb_darkening: f32,
 }
 
 impl SunDisc {
-    /// Radiance seen in direction `dir`: `E / Omega` inside the disc of solid angle
-    /// `Omega = 2 pi (1 - cos r)`, zero outside and for a point sun. The compositor draws this
-    /// disc and the path tracer sees it.
-    pub fn radiance(&self, dir: Vec3) -> Vec3 {
-        let solid_angle = TAU * (1.0 - self.cos_radius);
-        if solid_angle > 0.0 && dir.dot(self.direction) >= self.cos_radius {
-            self.irradiance / solid_angle
-        } else {
-            Vec3::ZERO
+    /// Radiance seen in direction `dir` for a disc of irradiance `irradiance`: inside the disc of
+    /// solid angle `Omega = 2 pi (1 - cos r)`, `E / Omega (1 - u (1 - mu)) / (1 - u / 3)`, where
+    /// `mu = sqrt(1 - (theta / r)^2)` is the cosine on the solar surface and `1 - u / 3` the
+    /// law's mean over the disc, so the disc integrates to `E`; zero outside and for a point sun.
+    /// The compositor draws this disc and the path tracer sees it.
+    pub fn radiance_of(&self, irradiance: Vec3, dir: Vec3) -> Vec3 {
+        let one_minus_cos_radius = 1.0 - self.cos_radius;
+        let cos_angle = dir.dot(self.direction);
+        if one_minus_cos_radius <= 0.0 || cos_angle < self.cos_radius {
+            return Vec3::ZERO;
         }
+        let u = self.limb_darkening;
+        let mu = (1.0 - (1.0 - cos_angle) / one_minus_cos_radius)
+            .clamp(0.0, 1.0)
+            .sqrt();
+        let limb = (1.0 - u * (1.0 - mu)) / (1.0 - u / 3.0);
+        irradiance * limb / (TAU * one_minus_cos_radius)
+    }
+
+    /// [`SunDisc::radiance_of`] the disc's own irradiance.
+    pub fn radiance(&self, dir: Vec3) -> Vec3 {
+        self.radiance_of(self.irradiance, dir)
     }
 }
 
-/// Sun, sky and haze: the CPU twin of `environment.wgsl`.
+/// Sun, sky and haze as a scene describes them, before any viewpoint: the uniform of
+/// `environment.wgsl`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Environment {
     /// The sun.
     pub sun: SunDisc,
-    /// The sky and its haze.
+    /// The analytic sky and its haze (used by the gradient and constant models).
     pub sky: SkyRadiance,
+    /// Which sky lights the scene.
+    pub sky_model: SkyModel,
+    /// The air of the atmosphere model.
+    pub air: Air,
 }
 
 impl Environment {
@@ -121,25 +162,127 @@ impl Environment {
                 direction: direction_from_angles_deg(s.elevation_deg, s.azimuth_deg),
                 irradiance: Vec3::from_array(s.color) * s.irradiance,
                 cos_radius: s.angular_radius_deg.to_radians().cos(),
+                limb_darkening: SUN_LIMB_DARKENING,
             },
             sky: SkyRadiance::from_scene(scene),
+            sky_model: scene.sky.model,
+            air: Air::from_scene(scene),
         }
     }
 
-    /// What the eye sees of `radiance` (scattered by something covering fraction `coverage` of
-    /// the pixel) from `distance_m` away through the haze: it fades toward the horizon radiance by
-    /// `exp(-haze distance)` (Koschmieder 1924), weighted by the coverage.
-    pub fn aerial_perspective(&self, radiance: Vec3, coverage: f32, distance_m: f32) -> Vec3 {
-        let clear = (-self.sky.haze_per_m * distance_m).exp();
-        radiance * clear + self.sky.horizon * coverage * (1.0 - clear)
+}
+
+/// The environment seen from one viewpoint: the CPU twin of every function of `environment.wgsl`
+/// but the shadow map's ([`crate::shadow::CloudShadowMap`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewedEnvironment {
+    /// The scene's environment.
+    pub env: Environment,
+    /// World point the sky and the aerial perspective are seen from.
+    pub viewpoint_m: Vec3,
+    /// The atmosphere's tables and the sky from the viewpoint (atmosphere model only).
+    pub atmosphere: Option<(Arc<Atmosphere>, SkyView)>,
+}
+
+impl ViewedEnvironment {
+    /// `env` seen from `viewpoint_m`; builds (or reuses) the atmosphere's tables when its model
+    /// is the atmosphere.
+    pub fn new(env: &Environment, viewpoint_m: Vec3) -> ViewedEnvironment {
+        let atmosphere = (env.sky_model == SkyModel::Atmosphere).then(|| {
+            let atmosphere = Atmosphere::shared(&env.air);
+            let view = SkyView::new(&atmosphere, viewpoint_m, env.sun.direction);
+            (atmosphere, view)
+        });
+        ViewedEnvironment {
+            env: *env,
+            viewpoint_m,
+            atmosphere,
+        }
     }
 
-    /// Radiance leaving a Lambertian ground of `albedo` under the unshadowed sun and sky:
-    /// `albedo / pi * (E_sun max(0, sun.y) + E_sky)`.
-    pub fn ground_radiance(&self, albedo: Vec3) -> Vec3 {
-        let irradiance =
-            self.sun.irradiance * self.sun.direction.y.max(0.0) + self.sky.irradiance_up();
-        albedo * irradiance / PI
+    /// Transmittance of the air from `p` toward the sun (1 for the analytic skies):
+    /// `environment_sun_transmittance`.
+    pub fn sun_transmittance(&self, p: Vec3) -> Vec3 {
+        match &self.atmosphere {
+            Some((atmosphere, _)) => atmosphere.sun_transmittance(p, self.env.sun.direction),
+            None => Vec3::ONE,
+        }
+    }
+
+    /// Sun irradiance reaching `p` on a surface facing the sun: `environment_sun_irradiance`.
+    pub fn sun_irradiance(&self, p: Vec3) -> Vec3 {
+        self.env.sun.irradiance * self.sun_transmittance(p)
+    }
+
+    /// Radiance of the sun's disc seen from the viewpoint along `dir`:
+    /// `environment_sun_disc_radiance`.
+    pub fn sun_disc_radiance(&self, dir: Vec3) -> Vec3 {
+        let irradiance = self.sun_irradiance(self.viewpoint_m);
+        self.env.sun.radiance_of(irradiance, dir)
+    }
+
+    /// Sky radiance arriving at the viewpoint from `dir`, the disc excluded:
+    /// `environment_sky_radiance`.
+    pub fn sky_radiance(&self, dir: Vec3) -> Vec3 {
+        match &self.atmosphere {
+            Some((atmosphere, view)) => {
+                self.env.sun.irradiance * view.radiance(atmosphere.air(), dir)
+            }
+            None => self.env.sky.radiance(dir),
+        }
+    }
+
+    /// Mean sky radiance over the upper hemisphere at `p`: `environment_sky_mean_radiance_up`.
+    pub fn sky_mean_radiance_up(&self, p: Vec3) -> Vec3 {
+        self.irradiance_table(p, 1)
+            .unwrap_or_else(|| self.env.sky.mean_radiance_up())
+    }
+
+    /// Sky irradiance on an upward-facing surface at `p`: `environment_sky_irradiance_up`.
+    pub fn sky_irradiance_up(&self, p: Vec3) -> Vec3 {
+        self.irradiance_table(p, 0)
+            .unwrap_or_else(|| self.env.sky.irradiance_up())
+    }
+
+    fn irradiance_table(&self, p: Vec3, layer: usize) -> Option<Vec3> {
+        let (atmosphere, _) = self.atmosphere.as_ref()?;
+        let sun = &self.env.sun;
+        Some(sun.irradiance * atmosphere.sky_irradiance(p, sun.direction, layer))
+    }
+
+    /// Radiance leaving a Lambertian ground of `albedo` at `p` under the unshadowed sun and sky:
+    /// `albedo / pi * (E_sun(p) max(0, sun.y) + E_sky(p))` (`environment_ground_radiance`).
+    pub fn ground_radiance(&self, albedo: Vec3, p: Vec3) -> Vec3 {
+        let sun = self.sun_irradiance(p) * self.env.sun.direction.y.max(0.0);
+        albedo * (sun + self.sky_irradiance_up(p)) / PI
+    }
+
+    /// What the eye at the viewpoint sees of `radiance`, scattered by something covering
+    /// fraction `coverage` of the pixel, `distance_m` along `dir`: with the atmosphere,
+    /// `radiance T + coverage L_air`, the air's transmittance and in-scattered light over that
+    /// distance (the sun's single scattering dimmed by `sun_visibility(t)`, the clouds' shadow at
+    /// distance `t`); with the analytic skies, a fade toward the horizon radiance by
+    /// `exp(-haze distance)` (Koschmieder 1924). `environment_aerial_perspective` reads the same
+    /// from its 32 slices.
+    pub fn aerial_perspective(
+        &self,
+        (radiance, coverage): (Vec3, f32),
+        (dir, distance_m): (Vec3, f32),
+        sun_visibility: impl Fn(f32) -> f32,
+    ) -> Vec3 {
+        match &self.atmosphere {
+            Some((atmosphere, _)) => {
+                let sun = self.env.sun.direction;
+                let ray = (self.viewpoint_m, dir);
+                let (light, through) =
+                    atmosphere.aerial_perspective(ray, sun, distance_m, sun_visibility);
+                radiance * through + self.env.sun.irradiance * light * coverage
+            }
+            None => {
+                let clear = (-self.env.sky.haze_per_m * distance_m).exp();
+                radiance * clear + self.env.sky.horizon * coverage * (1.0 - clear)
+            }
+        }
     }
 }
 

@@ -56,13 +56,20 @@ pub(crate) fn hg_lobes(phase: &PhaseFunction) -> Vec<HgLobe> {
 /// Radiance of a constant sky that gives a horizontal surface the same irradiance as the scene's
 /// sky: the cosine-weighted mean of its radiance over the upper hemisphere, `E_up / pi`
 /// ([`SkyRadiance::irradiance_up`]). For the gradient `L = H + (Z - H) sin(elevation)^k` this is
-/// `H + (Z - H) 2 / (k + 2)`. A constant sky keeps its radiance exactly (no round trip through
+/// `H + (Z - H) 2 / (k + 2)`; for the atmosphere, its irradiance table at the camera. A constant
+/// sky keeps its radiance exactly (no round trip through
 /// `pi`). The lower hemisphere gets the same radiance (hidden by the ground when there is one).
 pub(crate) fn constant_sky_radiance(scene: &Scene) -> [f32; 3] {
     match scene.sky.model {
         SkyModel::Constant => scene.sky.radiance,
         SkyModel::Gradient => {
             (SkyRadiance::from_scene(scene).irradiance_up() / std::f32::consts::PI).to_array()
+        }
+        SkyModel::Atmosphere => {
+            let env = crate::environment::Environment::from_scene(scene);
+            let camera = glam::Vec3::from_array(scene.camera.position_m);
+            let viewed = crate::environment::ViewedEnvironment::new(&env, camera);
+            (viewed.sky_irradiance_up(camera) / std::f32::consts::PI).to_array()
         }
     }
 }

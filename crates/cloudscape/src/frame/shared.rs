@@ -57,11 +57,23 @@ impl<'a> Shared<'a> {
         slots: SharedSlots,
         pass: &'a wgpu::BindGroup,
     ) -> [Option<&'a wgpu::BindGroup>; 4] {
-        let [field, frame, environment] = slots.used;
+        self.bind_groups_with(slots, self.environment.bind_group(), pass)
+    }
+
+    /// [`Shared::bind_groups`] for a pass that writes one of the environment's tables: with
+    /// `environment`, the group that holds a stand-in for it
+    /// ([`EnvironmentGpu::bind_group_writing`]).
+    pub fn bind_groups_with(
+        &self,
+        slots: SharedSlots,
+        environment: &'a wgpu::BindGroup,
+        pass: &'a wgpu::BindGroup,
+    ) -> [Option<&'a wgpu::BindGroup>; 4] {
+        let [field, frame, uses_environment] = slots.used;
         [
             field.then_some(self.field.bind_group()),
             frame.then_some(self.frame.bind_group()),
-            environment.then_some(self.environment.bind_group()),
+            uses_environment.then_some(environment),
             Some(pass),
         ]
     }

@@ -90,10 +90,18 @@ pub fn float_texture(dimension: wgpu::TextureViewDimension) -> wgpu::BindingType
 
 /// A write-only 2D storage texture binding.
 pub fn storage_texture_2d(format: wgpu::TextureFormat) -> wgpu::BindingType {
+    storage_texture(format, wgpu::TextureViewDimension::D2)
+}
+
+/// A write-only storage texture binding of the given dimension.
+pub fn storage_texture(
+    format: wgpu::TextureFormat,
+    view_dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindingType {
     wgpu::BindingType::StorageTexture {
         access: wgpu::StorageTextureAccess::WriteOnly,
         format,
-        view_dimension: wgpu::TextureViewDimension::D2,
+        view_dimension,
     }
 }
 

@@ -10,58 +10,37 @@
 @group(3) @binding(3) var compose_host_depth: texture_2d<f32>;
 @group(3) @binding(4) var compose_out: texture_storage_2d<rgba16float, write>;
 
-// Samples of the coarse optical depth from the ground through the layers, and again through the
-// voxel-grid boxes: uniform segments (unlike the march's doubling ones, which are fine near a point
-// inside the cloud), so the clouds far along the ray are sampled as finely as near ones.
-const COMPOSE_SHADOW_STEPS: u32 = 24u;
-
-// Coarse optical depth from ground point g toward dir over the ray stretch [span.x, span.y].
-fn compose_span_optical_depth(g: vec3<f32>, dir: vec3<f32>, span: vec2<f32>, jitter: f32) -> f32 {
-    if span.x >= span.y {
-        return 0.0;
-    }
-    return field_optical_depth_coarse(g, dir, vec3<f32>(span.x, span.y - span.x, 1.0), COMPOSE_SHADOW_STEPS, jitter);
-}
-
-// Coarse optical depth of the clouds from ground point g toward dir (upward): the layers, then the
-// voxel-grid boxes.
-fn compose_optical_depth(g: vec3<f32>, dir: vec3<f32>, jitter: f32) -> f32 {
-    let layers = field_layer_interval(g, dir, FIELD_NO_HIT);
-    let volumes = field_volume_interval(g, dir, FIELD_NO_HIT);
-    return compose_span_optical_depth(g, dir, layers, jitter) + compose_span_optical_depth(g, dir, volumes, jitter);
-}
-
 // Radiance leaving the Lambertian ground at g: the sun's and the sky's share of ground_radiance,
-// each dimmed by the clouds' diffuse transmittance between the ground and the light (the sun's
-// along its slant path: the direct beam and the light the clouds scatter forward, most of it
-// within a few degrees of the sun), as the path tracer's ground sees them through the same field:
-// environment_ground_radiance, shadowed.
-fn compose_ground(g: vec3<f32>, jitter: f32) -> vec3<f32> {
+// each dimmed by the clouds' diffuse transmittance between the ground and the light, read from the
+// shared shadow map (the sun's along its slant path: the direct beam and the light the clouds
+// scatter forward, most of it within a few degrees of the sun), as the path tracer's ground sees
+// them through the same field: environment_ground_radiance, shadowed.
+fn compose_ground(g: vec3<f32>) -> vec3<f32> {
     let sun = environment_sun_direction();
     let sun_part = frame.ground_albedo / PI * environment_sun_irradiance(g) * max(sun.y, 0.0);
     let sky_part = frame.ground_albedo / PI * environment_sky_irradiance_up(g);
     var sun_t = 0.0;
     if sun.y > 0.0 {
-        sun_t = frame_diffuse_transmittance(compose_optical_depth(g, sun, jitter));
+        sun_t = environment_cloud_sun_visibility(g);
     }
-    let sky_t = frame_diffuse_transmittance(compose_optical_depth(g, field_up(g), jitter));
+    let sky_t = frame_diffuse_transmittance(environment_cloud_sky_optical_depth(g));
     return sun_part * sun_t + sky_part * sky_t;
 }
 
 // What lies behind the clouds along the ray through pixel `px`, as the eye sees it through the haze.
 fn compose_background(px: vec2<u32>) -> vec3<f32> {
     let pixel = vec2<f32>(px) + 0.5;
+    let uv = pixel / frame.viewport_px;
     let o = frame.camera_position_m;
     let d = frame_ray_direction(pixel);
     let host_depth = textureLoad(compose_host_depth, vec2<i32>(px), 0).x;
     if frame_has_geometry(host_depth) {
         let host = textureLoad(compose_host_color, vec2<i32>(px), 0).rgb;
-        return environment_aerial_perspective(host, 1.0, frame_depth_distance(pixel, host_depth));
+        return environment_aerial_perspective(host, 1.0, uv, frame_depth_distance(pixel, host_depth));
     }
     let ground_m = field_ground_distance(o, d, frame.has_ground == 1u);
     if ground_m < frame.far_m {
-        let jitter = frame_pixel_jitter(px, frame.frame_index);
-        return environment_aerial_perspective(compose_ground(o + d * ground_m, jitter), 1.0, ground_m);
+        return environment_aerial_perspective(compose_ground(o + d * ground_m), 1.0, uv, ground_m);
     }
     return environment_sky_radiance(d) + environment_sun_disc_radiance(d);
 }
@@ -73,6 +52,7 @@ fn compose_clouds_over_background(@builtin(global_invocation_id) id: vec3<u32>) 
     }
     let clouds = textureLoad(compose_clouds, vec2<i32>(id.xy), 0);
     let distance_m = textureLoad(compose_cloud_distance, vec2<i32>(id.xy), 0).x;
-    let hazed = environment_aerial_perspective(clouds.rgb, 1.0 - clouds.a, distance_m);
+    let uv = (vec2<f32>(id.xy) + 0.5) / frame.viewport_px;
+    let hazed = environment_aerial_perspective(clouds.rgb, 1.0 - clouds.a, uv, distance_m);
     textureStore(compose_out, vec2<i32>(id.xy), vec4<f32>(compose_background(id.xy) * clouds.a + hazed, 1.0));
 }

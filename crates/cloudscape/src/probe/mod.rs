@@ -25,14 +25,14 @@ pub enum ProbeFunction {
     CameraRay = 3,
     /// `frame_depth_distance(a.xy, depth a.z)`: `Frame::depth_distance_m` (1e30 for none).
     DepthDistance = 4,
-    /// `environment_aerial_perspective(a.xyz, coverage a.w, distance b.x)`:
-    /// `Environment::aerial_perspective`.
+    /// `environment_aerial_perspective(a.xyz, coverage a.w, screen uv b.yz, distance b.x)`:
+    /// `ViewedEnvironment::aerial_perspective`.
     AerialPerspective = 5,
-    /// `environment_sun_disc_radiance(a.xyz)`: `SunDisc::radiance`.
+    /// `environment_sun_disc_radiance(a.xyz)`: `ViewedEnvironment::sun_disc_radiance`.
     SunDiscRadiance = 6,
-    /// `environment_sky_radiance(a.xyz)`: `SkyRadiance::radiance`.
+    /// `environment_sky_radiance(a.xyz)`: `ViewedEnvironment::sky_radiance`.
     SkyRadiance = 7,
-    /// `environment_ground_radiance(albedo a.xyz, b.xyz)`: `Environment::ground_radiance`.
+    /// `environment_ground_radiance(albedo a.xyz, b.xyz)`: `ViewedEnvironment::ground_radiance`.
     GroundRadiance = 8,
     /// `tonemap_aces(a.xyz)`: `tonemap::aces`.
     ToneMapAces = 9,
@@ -47,6 +47,16 @@ pub enum ProbeFunction {
     Phase = 13,
     /// `field_height_gradient(type a.x, height fraction a.y)`: `profile::height_gradient`.
     HeightGradient = 14,
+    /// `environment_sun_irradiance(a.xyz)`: `ViewedEnvironment::sun_irradiance`.
+    SunIrradiance = 15,
+    /// `environment_sky_irradiance_up(a.xyz)`: `ViewedEnvironment::sky_irradiance_up`.
+    SkyIrradianceUp = 16,
+    /// `environment_sky_mean_radiance_up(a.xyz)`: `ViewedEnvironment::sky_mean_radiance_up`.
+    SkyMeanRadianceUp = 17,
+    /// `environment_cloud_sun_optical_depth(a.xyz)`: `CloudShadowMap::optical_depth(p, 0)`.
+    CloudSunOpticalDepth = 18,
+    /// `environment_cloud_sky_optical_depth(a.xyz)`: `CloudShadowMap::optical_depth(p, 1)`.
+    CloudSkyOpticalDepth = 19,
 }
 
 /// The inputs of one evaluation.

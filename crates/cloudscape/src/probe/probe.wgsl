@@ -22,7 +22,7 @@ fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
         case 2u: { return vec4<f32>(field_optical_depth_coarse(a.xyz, b.xyz, vec3<f32>(0.0, a.w, b.w), 16u, 0.5)); }
         case 3u: { return vec4<f32>(frame_ray_direction(a.xy), 0.0); }
         case 4u: { return vec4<f32>(min(frame_depth_distance(a.xy, a.z), 1.0e30)); }
-        case 5u: { return vec4<f32>(environment_aerial_perspective(a.xyz, a.w, b.x), 0.0); }
+        case 5u: { return vec4<f32>(environment_aerial_perspective(a.xyz, a.w, b.yz, b.x), 0.0); }
         case 6u: { return vec4<f32>(environment_sun_disc_radiance(a.xyz), 0.0); }
         case 7u: { return vec4<f32>(environment_sky_radiance(a.xyz), 0.0); }
         case 8u: { return vec4<f32>(environment_ground_radiance(a.xyz, b.xyz), 0.0); }
@@ -32,6 +32,11 @@ fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
         case 12u: { return vec4<f32>(frame_diffuse_transmittance(a.x)); }
         case 13u: { return vec4<f32>(phase_eval(phase_scaled(a, b.y), b.x)); }
         case 14u: { return vec4<f32>(field_height_gradient(a.x, a.y)); }
+        case 15u: { return vec4<f32>(environment_sun_irradiance(a.xyz), 0.0); }
+        case 16u: { return vec4<f32>(environment_sky_irradiance_up(a.xyz), 0.0); }
+        case 17u: { return vec4<f32>(environment_sky_mean_radiance_up(a.xyz), 0.0); }
+        case 18u: { return vec4<f32>(environment_cloud_sun_optical_depth(a.xyz)); }
+        case 19u: { return vec4<f32>(environment_cloud_sky_optical_depth(a.xyz)); }
         default: { return vec4<f32>(-1.0); }
     }
 }

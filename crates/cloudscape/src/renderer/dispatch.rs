@@ -38,7 +38,7 @@ mod tests {
         let field = crate::field::CloudField::new(&scene, Path::new(".")).unwrap();
         let field_gpu = crate::field::gpu::FieldGpu::new(&ctx, &field);
         let frame = crate::frame::FrameGpu::new(&ctx, "frame");
-        let environment = crate::environment::EnvironmentGpu::new(&ctx, "environment");
+        let environment = crate::environment::EnvironmentGpu::new(&ctx, 16);
         let shared = Shared {
             field: &field_gpu,
             frame: &frame,

@@ -7,7 +7,7 @@
 //! statistics come back a frame late ([`CloudRenderer::stats`]).
 
 use super::dispatch;
-use crate::environment::{Environment, EnvironmentGpu, EnvironmentUniform};
+use crate::environment::{Environment, EnvironmentGpu, EnvironmentPasses, EnvironmentUniform};
 use crate::field::gpu::{FieldGpu, FieldUpdate};
 use crate::field::{CloudField, FieldError};
 use crate::frame::{Frame, FrameGpu, Shared};
@@ -17,6 +17,7 @@ use crate::output::{CloudOutput, SampleGrid};
 use crate::post::upsample::Upsampler;
 use crate::post::{Background, Compositor, DISPLAY_FORMAT, Display, HDR_FORMAT};
 use crate::scene::Scene;
+use crate::shadow::ShadowParams;
 use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use crate::temporal::{TemporalResolve, TemporalSettings};
 use glam::{UVec2, Vec2};
@@ -78,6 +79,9 @@ pub struct CloudRenderer {
     field_gpu: FieldGpu,
     frame_gpu: FrameGpu,
     environment_gpu: EnvironmentGpu,
+    environment_passes: EnvironmentPasses,
+    /// The environment of the last frame begun, and whether its passes still need recording.
+    environment: (Environment, bool),
     technique: Box<dyn Technique>,
     temporal: Option<TemporalResolve>,
     upsampler: Upsampler,
@@ -99,13 +103,14 @@ impl CloudRenderer {
         let field = CloudField::new(scene, base_dir)?;
         let field_gpu = FieldGpu::new(ctx, &field);
         let frame_gpu = FrameGpu::new(ctx, "frame");
-        let environment_gpu = EnvironmentGpu::new(ctx, "environment");
+        let environment_gpu = EnvironmentGpu::new(ctx, scene.shadow.resolution);
         let shared = Shared {
             field: &field_gpu,
             frame: &frame_gpu,
             environment: &environment_gpu,
         };
         let technique = dispatch::build(ctx, &shared, scene, base_dir)?;
+        let environment_passes = EnvironmentPasses::new(ctx, &shared);
         let compositor = Compositor::new(ctx, &shared);
         let upsampler = Upsampler::new(ctx, &shared);
         Ok(CloudRenderer {
@@ -113,6 +118,8 @@ impl CloudRenderer {
             field_gpu,
             frame_gpu,
             environment_gpu,
+            environment_passes,
+            environment: (Environment::from_scene(scene), false),
             technique,
             temporal: None,
             upsampler,
@@ -173,8 +180,10 @@ impl CloudRenderer {
         self.technique.name()
     }
 
-    /// The labels of a frame's passes as a [`PassTimer`] records them, in order: the technique's
-    /// ([`Technique::pass_names`]), "temporal resolve" (with temporal reuse), "compose", "display".
+    /// The labels of a frame's passes as a [`PassTimer`] records them, in order: the
+    /// environment's ([`EnvironmentPasses::pass_names`]: the shadow map and the sky's tables), the
+    /// technique's ([`Technique::pass_names`]), "temporal resolve" (with temporal reuse),
+    /// "compose", "display".
     pub fn pass_names(&self) -> Vec<&'static str> {
         let shared = [
             "temporal resolve",
@@ -182,10 +191,9 @@ impl CloudRenderer {
             "compose",
             "display",
         ];
-        self.technique
-            .pass_names()
-            .iter()
-            .copied()
+        EnvironmentPasses::pass_names(&self.environment.0)
+            .into_iter()
+            .chain(self.technique.pass_names().iter().copied())
             .chain(shared)
             .collect()
     }
@@ -225,8 +233,14 @@ impl CloudRenderer {
         self.targets.as_mut().expect("targets were just made").grid = grid;
         self.field_gpu.set_time(ctx, &self.field, frame.time_s);
         self.frame_gpu.write(ctx, &frame.uniform(&grid));
-        let environment = EnvironmentUniform::new(&Environment::from_scene(scene));
-        self.environment_gpu.write(ctx, &environment);
+        let env = Environment::from_scene(scene);
+        let viewpoint = frame.camera_position_m;
+        let shadow = ShadowParams::new(scene, &self.field, viewpoint, env.sun.direction);
+        self.environment_gpu
+            .resize_shadow_map(ctx, scene.shadow.resolution);
+        let uniform = EnvironmentUniform::new(&env, viewpoint, &shadow);
+        self.environment_gpu.write(ctx, &uniform);
+        self.environment = (env, true);
         let inputs = FrameInputs {
             scene,
             field: &self.field,
@@ -238,15 +252,17 @@ impl CloudRenderer {
         self.reuse = reuse;
     }
 
-    /// Records the technique over output texels `region` (origin, size; None for all of them).
+    /// Records the technique over output texels `region` (origin, size; None for all of them),
+    /// after the frame's environment passes (shadow map, sky tables) on the frame's first call.
     pub fn encode_clouds(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         host_depth: &wgpu::TextureView,
         region: Option<(UVec2, UVec2)>,
-        timer: Option<&mut PassTimer>,
+        mut timer: Option<&mut PassTimer>,
     ) {
+        self.encode_environment(ctx, encoder, timer.as_deref_mut());
         let shared = Shared {
             field: &self.field_gpu,
             frame: &self.frame_gpu,
@@ -264,6 +280,29 @@ impl CloudRenderer {
         let timer = timer.map(|t| (t, self.technique.name()));
         self.technique
             .encode(ctx, encoder, &shared, &targets, region, timer);
+    }
+
+    /// Records the frame's environment passes (the clouds' shadow map and the sky's tables) once
+    /// per [`CloudRenderer::begin_frame`]; [`CloudRenderer::encode_clouds`] calls it first, and a
+    /// host that reads the environment without drawing clouds calls it itself.
+    pub fn encode_environment(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: Option<&mut PassTimer>,
+    ) {
+        let (env, pending) = &mut self.environment;
+        if !*pending {
+            return;
+        }
+        let shared = Shared {
+            field: &self.field_gpu,
+            frame: &self.frame_gpu,
+            environment: &self.environment_gpu,
+        };
+        self.environment_passes
+            .encode(ctx, encoder, &shared, env, timer);
+        *pending = false;
     }
 
     /// Records the rest of the frame: temporal reuse, composition over `background` with aerial

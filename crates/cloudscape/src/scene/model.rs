@@ -19,6 +19,8 @@ pub struct Scene {
     pub sun: Sun,
     /// Sky light falling on the clouds and seen behind them.
     pub sky: Sky,
+    /// The clouds' shadow map.
+    pub shadow: Shadow,
     /// The ground below the clouds (the planet surface, or a flat plane).
     pub ground: Ground,
     /// The planet's shape.
@@ -55,6 +57,7 @@ impl Default for Scene {
             camera: Camera::default(),
             sun: Sun::default(),
             sky: Sky::default(),
+            shadow: Shadow::default(),
             ground: Ground::default(),
             planet: Planet::default(),
             layers: vec![CloudLayer::default()],
@@ -114,7 +117,8 @@ pub struct Sun {
     pub elevation_deg: f32,
     /// Azimuth in degrees clockwise from north.
     pub azimuth_deg: f32,
-    /// Irradiance on a surface facing the sun, in scene radiometric units (> 0 or 0 for no sun).
+    /// Irradiance on a surface facing the sun, in scene radiometric units (> 0 or 0 for no sun);
+    /// above the air with the atmosphere, which reddens it on its way down.
     pub irradiance: f32,
     /// Linear RGB colour multiplying the irradiance, each 0..1.
     pub color: [f32; 3],
@@ -128,7 +132,7 @@ impl Default for Sun {
             elevation_deg: 30.0,
             azimuth_deg: 215.0,
             irradiance: 8.0,
-            color: [1.0, 0.96, 0.90],
+            color: [1.0, 1.0, 1.0],
             angular_radius_deg: 0.2679,
         }
     }
@@ -142,9 +146,12 @@ pub enum SkyModel {
     Constant,
     /// Horizon radiance blending to zenith radiance with elevation.
     Gradient,
+    /// A physically based atmosphere (Rayleigh, Mie, ozone; Hillaire 2020): the sun's colour at
+    /// every altitude, the sky and the aerial perspective follow from the sun's place.
+    Atmosphere,
 }
 
-/// Sky light. The physically based atmosphere comes later; these are its simple stand-ins.
+/// Sky light: the physically based atmosphere, or its simple analytic stand-ins.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Sky {
@@ -158,20 +165,46 @@ pub struct Sky {
     pub horizon_radiance: [f32; 3],
     /// Gradient sky: how fast the horizon colour gives way to the zenith colour, 0.05..10.
     pub gradient_exponent: f32,
-    /// Meteorological visibility in metres, 100..10 000 000: distant clouds and ground fade into the
-    /// horizon radiance with extinction 3.912 / visibility (Koschmieder).
+    /// Meteorological visibility in metres, 100..10 000 000: the extinction 3.912 / visibility at
+    /// the ground (Koschmieder). The atmosphere puts what Rayleigh leaves of it into its aerosol
+    /// (Mie) layer; the analytic skies fade distant clouds and ground into the horizon radiance.
     pub visibility_m: f32,
 }
 
 impl Default for Sky {
     fn default() -> Self {
         Sky {
-            model: SkyModel::Gradient,
+            model: SkyModel::Atmosphere,
             radiance: [0.3, 0.3, 0.3],
             zenith_radiance: [0.10, 0.22, 0.52],
             horizon_radiance: [0.42, 0.50, 0.62],
             gradient_exponent: 0.45,
             visibility_m: 80_000.0,
+        }
+    }
+}
+
+/// The clouds' shared shadow map (light-space transmittance), built from the coarse field each
+/// frame: it shades the ground, the air's light shafts and a host's geometry. It reaches the
+/// camera's far distance around the viewpoint.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Shadow {
+    /// Texels per side of the map, 16..4096.
+    pub resolution: u32,
+    /// Samples of the coarse field along each column through the clouds, 4..256.
+    pub steps: u32,
+    /// Texel size under the viewpoint over the mean texel size, 0.05..1 (1: no warp; smaller
+    /// gives finer shadows near the eye and coarser far away).
+    pub warp: f32,
+}
+
+impl Default for Shadow {
+    fn default() -> Self {
+        Shadow {
+            resolution: 256,
+            steps: 16,
+            warp: 0.25,
         }
     }
 }

@@ -1,0 +1,53 @@
+//! The environment's passes of a frame: the clouds' shadow map, then (with the atmosphere) the
+//! sky's tables, before any technique reads them.
+
+use super::{Environment, SkyModel};
+use crate::atmosphere::gpu::{AtmospherePasses, FRAME_PASS_NAMES, TABLE_PASS_NAMES};
+use crate::frame::Shared;
+use crate::gpu::{GpuContext, PassTimer};
+use crate::shadow::gpu::{CloudShadowPass, SHADOW_PASS_NAME};
+
+/// The shadow-map pass and the atmosphere's table passes, made once.
+pub struct EnvironmentPasses {
+    shadow: CloudShadowPass,
+    atmosphere: AtmospherePasses,
+}
+
+impl EnvironmentPasses {
+    /// Builds the pipelines against the shared groups.
+    pub fn new(ctx: &GpuContext, shared: &Shared) -> EnvironmentPasses {
+        EnvironmentPasses {
+            shadow: CloudShadowPass::new(ctx, shared),
+            atmosphere: AtmospherePasses::new(ctx, shared),
+        }
+    }
+
+    /// Labels of a frame's environment passes, in order, for `env`: the shadow map, and with
+    /// the atmosphere the static tables (only in frames where the air changed) and the per-frame
+    /// ones.
+    pub fn pass_names(env: &Environment) -> Vec<&'static str> {
+        let mut names = vec![SHADOW_PASS_NAME];
+        if env.sky_model == SkyModel::Atmosphere {
+            names.extend(TABLE_PASS_NAMES);
+            names.extend(FRAME_PASS_NAMES);
+        }
+        names
+    }
+
+    /// Records the frame's passes for `env` (the uniform already written).
+    pub fn encode(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        shared: &Shared,
+        env: &Environment,
+        mut timer: Option<&mut PassTimer>,
+    ) {
+        self.shadow
+            .encode(ctx, encoder, shared, timer.as_deref_mut());
+        if env.sky_model == SkyModel::Atmosphere {
+            self.atmosphere
+                .encode(ctx, encoder, shared, &env.air, timer);
+        }
+    }
+}

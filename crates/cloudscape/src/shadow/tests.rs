@@ -1,0 +1,72 @@
+use super::*;
+use crate::scene::Scene;
+use std::path::Path;
+
+fn scene_field() -> (Scene, CloudField) {
+    let scene = Scene::default();
+    let field = CloudField::new(&scene, Path::new(".")).unwrap();
+    (scene, field)
+}
+
+fn sun() -> Vec3 {
+    Vec3::new(0.3, 0.6, -0.5).normalize()
+}
+
+#[test]
+fn the_warp_round_trips_and_is_finest_under_the_eye() {
+    let (scene, field) = scene_field();
+    let params = ShadowParams::new(&scene, &field, Vec3::ZERO, sun());
+    for s in [-0.9, -0.2, 0.0, 0.37, 1.0] {
+        assert!((params.coord_of(params.offset_of(s)) - s).abs() < 1e-5);
+    }
+    let texel = |i| {
+        let a = params.ground_point((i, 0), 256).x;
+        params.ground_point((i + 1, 0), 256).x - a
+    };
+    assert!(texel(128) < 0.5 * texel(250), "{} {}", texel(128), texel(250));
+    let edge = params.ground_point((255, 255), 256);
+    assert!(edge.x < params.half_extent_m && edge.x > 0.95 * params.half_extent_m);
+}
+
+#[test]
+fn columns_decrease_upward_and_match_the_direct_optical_depth() {
+    let (scene, field) = scene_field();
+    let params = ShadowParams::new(&scene, &field, Vec3::ZERO, sun());
+    let (mut checked, mut total_error) = (0, 0.0);
+    for k in 0..40 {
+        let g = Vec2::new(k as f32 * 731.0 - 14000.0, k as f32 * 377.0 - 7000.0);
+        let column = params.column(&field, (g, 0), sun(), 0.0);
+        assert!(column.windows(2).all(|w| w[0] >= w[1] - 1e-4), "{column:?}");
+        // Straight from the ground point toward the sun, finely sampled.
+        let p = Vec3::new(g.x, 0.0, g.y);
+        let direct = field.coarse_optical_depth((p, sun()), (0.0, 12_000.0, 1.0), (400, 0.5), 0.0);
+        if direct > 1.0 {
+            total_error += (column[0] - direct).abs() / direct;
+            checked += 1;
+        }
+    }
+    assert!(checked >= 5, "the sample must cross clouds: {checked}");
+    let mean_error = total_error / checked as f32;
+    assert!(mean_error < 0.25, "{mean_error}");
+}
+
+#[test]
+fn the_map_reads_the_columns_and_a_clear_sky_casts_nothing() {
+    let (scene, field) = scene_field();
+    let params = ShadowParams::new(&scene, &field, Vec3::ZERO, sun());
+    let map = CloudShadowMap::build(&field, params, sun(), (32, 0.0));
+    let ij = (9, 20);
+    let g = params.ground_point(ij, 32);
+    let column = map.columns[0][ij.1 as usize * 32 + ij.0 as usize];
+    let on_ground = map.optical_depth(Vec3::new(g.x, 0.0, g.y), 0);
+    assert!((on_ground - column[0]).abs() <= 1e-3 * column[0].max(1.0));
+    assert_eq!(map.optical_depth(Vec3::new(g.x, params.top_y_m + 1.0, g.y), 0), 0.0);
+
+    let mut clear = scene.clone();
+    clear.layers.clear();
+    let clear_field = CloudField::new(&clear, Path::new(".")).unwrap();
+    let clear_params = ShadowParams::new(&clear, &clear_field, Vec3::ZERO, sun());
+    assert!(!clear_params.enabled);
+    let clear_map = CloudShadowMap::build(&clear_field, clear_params, sun(), (8, 0.0));
+    assert_eq!(clear_map.optical_depth(Vec3::ZERO, 0), 0.0);
+}
