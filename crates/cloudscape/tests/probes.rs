@@ -368,6 +368,36 @@ fn atmosphere_functions_match_the_cpu() {
     }
 }
 
+/// The shared cloud shadow map, built on the GPU from the field, against the CPU map of the same
+/// field: the optical depth toward the sun and straight up from points on the ground, under and
+/// inside the layer. Both sample the coarse field at the same points; the GPU stores f16 and
+/// filters in its own precision: 2 % of the largest depth.
+#[test]
+fn the_cloud_shadow_map_matches_the_cpu() {
+    use cloudscape::shadow::{CloudShadowMap, ShadowParams};
+    let ctx = GpuContext::for_tests();
+    let mut scene = Scene::default();
+    scene.layers[0].coverage = 0.6;
+    scene.shadow.resolution = 48;
+    let frame = Frame::from_scene(&scene, SIZE);
+    let clouds = renderer(&ctx, &scene, &frame);
+    let sun = Environment::from_scene(&scene).sun.direction;
+    let params = ShadowParams::new(&scene, clouds.field(), frame.camera_position_m, sun);
+    let map = CloudShadowMap::build(clouds.field(), params, sun, (48, frame.time_s));
+    let points: Vec<Vec3> = (0..200)
+        .map(|i| {
+            let y = if i % 2 == 0 { 0.0 } else { 3000.0 * unit(i, 31) };
+            Vec3::new(30_000.0 * unit(i, 32) - 15_000.0, y, 30_000.0 * unit(i, 33) - 15_000.0)
+        })
+        .collect();
+    let probe = (&ctx, &clouds);
+    let sun_depth = |p| Vec3::splat(map.optical_depth(p, 0));
+    assert_points(probe, ProbeFunction::CloudSunOpticalDepth, &points, sun_depth, 0.02);
+    let sky_depth = |p| Vec3::splat(map.optical_depth(p, 1));
+    assert_points(probe, ProbeFunction::CloudSkyOpticalDepth, &points, sky_depth, 0.02);
+    assert!(points.iter().filter(|p| sun_depth(**p).x > 1.0).count() > 20, "clouds cast shadows");
+}
+
 /// A CPU tone-mapping function.
 type ColourMap = fn(Vec3) -> Vec3;
 
