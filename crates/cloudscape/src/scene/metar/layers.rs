@@ -16,11 +16,11 @@
 //!   layer's base by the 1/7 power law up to 1 km ([`wind_at_m_per_s`]).
 //! - **Haze**: the visibility group sets `sky.visibility_m` ([`scene_visibility_m`]).
 //! - **Obscured sky** (`VV`): a stratus (fog) layer from the ground to the vertical visibility,
-//!   whose extinction is the one the visibility group measures.
+//!   which leaves 5 % contrast at that height; the visibility group's haze fogs the view too.
 //! - `CAVOK`, `SKC`, `CLR`, `NSC`, `NCD`: no layers. Cloud groups whose base is not given (`///`)
 //!   are left out.
 
-use super::{Bound, CloudGroup, Convective, Cover, Report, SkyGroup, Visibility, Wind};
+use super::{CloudGroup, Convective, Cover, Report, SkyGroup, Visibility, Wind};
 use crate::field::profile::TYPE_GRADIENTS;
 use crate::scene::{CloudLayer, CloudTypeMix};
 
@@ -42,9 +42,7 @@ impl SceneWeather {
             .iter()
             .filter_map(|group| match group {
                 SkyGroup::Cloud(cloud) => cloud_layer(cloud),
-                SkyGroup::VerticalVisibility(height) => {
-                    Some(obscuring_layer(*height, report.visibility))
-                }
+                SkyGroup::VerticalVisibility(height) => Some(obscuring_layer(*height)),
                 SkyGroup::Clear(_) => None,
             })
             .collect();
@@ -141,27 +139,35 @@ struct Look {
 }
 
 /// Depths are typical values for each genus (rounded; e.g. Wallace & Hobbs 2006, *Atmospheric
-/// Science*, 2nd ed., chapter 6). Extinction is sigma = 3 LWC / (2 rho_w r_e) (physics.md) with
-/// typical liquid water content and effective radius: stratus and stratocumulus LWC 0.25-0.3 g/m^3,
-/// r_e 8-10 um (Miles, Verlinde & Clothiaux 2000, J. Atmos. Sci. 57) give 0.045 m^-1; cumulus
-/// 0.05 m^-1 and congestus and cumulonimbus 0.08 m^-1 within physics.md's 0.04-0.1 m^-1;
-/// altocumulus and altostratus LWC about 0.1 g/m^3 give 0.02 m^-1. Cirrus and cirrostratus,
-/// 1000 m of ice at 0.0015 m^-1, reach an optical depth of about 1.5 at their cores: opaque cirrus
-/// in Sassen & Cho's (1992, J. Appl. Meteor. 31) classes (thin 0.03-0.3, opaque 0.3-3).
+/// Science*, 2nd ed., chapter 6), taken at the thick end for the sheets: the field's noise varies
+/// little across a thin sheet, and its erosion then empties whole columns, so 300 m of stratus or
+/// 400 m of altocumulus left 10-50 % of an overcast sky clear (measured with
+/// `print_overcast_optical_depth` in `tests/metar.rs`); 800 m leaves no gaps. Extinction is
+/// sigma = 3 LWC / (2 rho_w r_e) (physics.md) with typical liquid water content and effective
+/// radius: stratus and stratocumulus LWC 0.25-0.3 g/m^3, r_e 8-10 um (Miles, Verlinde & Clothiaux
+/// 2000, J. Atmos. Sci. 57) give 0.045 m^-1 (an overcast sheet's median optical depth is then 7-10);
+/// cumulus 0.05 m^-1 and congestus and cumulonimbus 0.08 m^-1 within physics.md's 0.04-0.1 m^-1;
+/// altocumulus and altostratus LWC about 0.1 g/m^3 give 0.02 m^-1. Cirrus and cirrostratus, 1000 m
+/// of ice at 0.0045 m^-1, have median column optical depths of 1-1.4: opaque cirrus in Sassen &
+/// Cho's (1992, J. Appl. Meteor. 31) classes (thin 0.03-0.3, opaque 0.3-3).
+///
+/// The coverages were measured with `print_metar_coverage` in `tests/metar.rs` (400 columns over
+/// the default weather map, four layer seeds, a column cloudy above optical depth 1, or 0.3 for
+/// cirrus); re-measure when the field's noise or profiles change.
 #[rustfmt::skip]
 fn look(genus: CloudGenus) -> Look {
     use FieldType as T;
     let look = |field_type, depth_m, extinction_per_m, coverage| Look { field_type, depth_m, extinction_per_m, coverage };
     match genus {
-        CloudGenus::Stratus => look(T::Stratus, 300.0, 0.045, [0.25, 0.45, 0.7]),
-        CloudGenus::Stratocumulus => look(T::Stratocumulus, 500.0, 0.045, [0.25, 0.45, 0.7]),
-        CloudGenus::Cumulus => look(T::Cumulus, 1500.0, 0.05, [0.19, 0.44, 0.75]),
-        CloudGenus::ToweringCumulus => look(T::Cumulus, 4000.0, 0.08, [0.19, 0.44, 0.75]),
-        CloudGenus::Cumulonimbus => look(T::Cumulonimbus, 0.0, 0.08, [0.19, 0.44, 0.75]),
-        CloudGenus::Altocumulus => look(T::Stratocumulus, 400.0, 0.02, [0.25, 0.45, 0.7]),
-        CloudGenus::Altostratus => look(T::Stratus, 1000.0, 0.02, [0.25, 0.45, 0.7]),
-        CloudGenus::Cirrus => look(T::Stratocumulus, 1000.0, 0.0015, [0.25, 0.45, 0.7]),
-        CloudGenus::Cirrostratus => look(T::Stratus, 1000.0, 0.0015, [0.25, 0.45, 0.7]),
+        CloudGenus::Stratus => look(T::Stratus, 800.0, 0.045, [0.521, 0.788, 0.959]),
+        CloudGenus::Stratocumulus => look(T::Stratocumulus, 800.0, 0.045, [0.412, 0.709, 0.928]),
+        CloudGenus::Cumulus => look(T::Cumulus, 1500.0, 0.05, [0.477, 0.763, 0.946]),
+        CloudGenus::ToweringCumulus => look(T::Cumulus, 4000.0, 0.08, [0.353, 0.681, 0.903]),
+        CloudGenus::Cumulonimbus => look(T::Cumulonimbus, 0.0, 0.08, [0.074, 0.371, 0.723]),
+        CloudGenus::Altocumulus => look(T::Stratocumulus, 800.0, 0.02, [0.434, 0.750, 0.934]),
+        CloudGenus::Altostratus => look(T::Stratus, 1000.0, 0.02, [0.579, 0.824, 0.970]),
+        CloudGenus::Cirrus => look(T::Stratocumulus, 1000.0, 0.0045, [0.390, 0.709, 0.928]),
+        CloudGenus::Cirrostratus => look(T::Stratus, 1000.0, 0.0045, [0.598, 0.835, 0.975]),
     }
 }
 
@@ -242,20 +248,15 @@ pub fn scene_visibility_m(visibility: Visibility) -> f32 {
     (SCENE_CONTRAST_DEPTH / haze_extinction_per_m(visibility)).clamp(100.0, 1.0e7)
 }
 
-/// Extinction of fog when the report gives no visibility, m^-1: a visibility of 200 m.
-const FOG_VISIBILITY_M: f32 = 200.0;
-
-/// The obscuring layer of a `VV` group: stratus from the ground to the vertical visibility (at
-/// least 30 m; 100 ft when `VV///`), OVC, with the extinction the visibility group measures.
-fn obscuring_layer(height_hundreds_ft: Option<u32>, visibility: Option<Visibility>) -> CloudLayer {
+/// The obscuring layer of a `VV` group: stratus (fog) from the ground to the vertical visibility
+/// (at least 30 m; 100 ft when `VV///`), OVC. The vertical visibility is how far one sees up into
+/// the obscuring layer (ICAO Annex 3, appendix 3, 4.5.1), so its extinction is the MOR's,
+/// `ln(20) / VV`.
+fn obscuring_layer(height_hundreds_ft: Option<u32>) -> CloudLayer {
     let top_m = (height_hundreds_ft.unwrap_or(1) as f32 * 100.0 * super::METRES_PER_FOOT).max(30.0);
-    let visibility = visibility.unwrap_or(Visibility {
-        distance_m: FOG_VISIBILITY_M,
-        bound: Bound::Exact,
-    });
     CloudLayer {
         thickness_m: top_m / FieldType::Stratus.filled_fraction(),
-        extinction_per_m: haze_extinction_per_m(visibility).min(1.0),
+        extinction_per_m: (MOR_CONTRAST_DEPTH / top_m).min(1.0),
         ..CloudGenus::Stratus.layer(0.0, Cover::Overcast)
     }
 }
@@ -317,7 +318,7 @@ mod tests {
     fn layer_bands_give_the_genus_depth_to_the_type_profile() {
         let stratus = CloudGenus::Stratus.layer(120.0, Cover::Overcast);
         assert_eq!(stratus.types.stratus, 1.0);
-        assert!((stratus.thickness_m * TYPE_GRADIENTS[0][3] - 300.0).abs() < 1e-3);
+        assert!((stratus.thickness_m * TYPE_GRADIENTS[0][3] - 800.0).abs() < 1e-3);
         assert_eq!(stratus.coverage, 1.0);
         let cb = CloudGenus::Cumulonimbus.layer(1372.0, Cover::Broken);
         assert!((cb.bottom_m + cb.thickness_m - CUMULONIMBUS_TOP_M).abs() < 1e-3);
@@ -384,7 +385,7 @@ mod tests {
             (0.0, 1.0, 1.0)
         );
         assert!((fog.thickness_m * TYPE_GRADIENTS[0][3] - 30.48).abs() < 1e-3);
-        assert!((fog.extinction_per_m - 2.9957 / 150.0).abs() < 1e-5);
+        assert!((fog.extinction_per_m - 2.9957 / 30.48).abs() < 1e-4);
     }
 
     #[test]
