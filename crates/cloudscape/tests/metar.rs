@@ -448,3 +448,30 @@ fn print_overcast_optical_depth() {
         );
     }
 }
+
+#[test]
+fn the_example_scenes_draw_their_reports() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let load = |name: &str| {
+        SceneDocument::load(Some(&dir.join(name)), &[])
+            .unwrap_or_else(|e| panic!("{e}"))
+            .scene
+    };
+    let stratus = load("metar-low-stratus.toml");
+    let [deck] = &stratus.layers[..] else {
+        panic!("{:?}", stratus.layers)
+    };
+    assert_eq!(
+        (deck.types.stratus, deck.coverage),
+        (1.0, 1.0),
+        "OVC004 is a stratus sheet"
+    );
+    assert!((deck.bottom_m - 121.92).abs() < 0.01);
+    let fair = load("metar-fair-weather.toml");
+    assert_eq!(fair.layers.len(), 2);
+    assert!(fair.layers.iter().all(|l| l.types.cumulus == 1.0));
+    assert_eq!(load("metar-egll.toml").layers.len(), 4);
+    let storm = load("metar-thunderstorm.toml");
+    assert_eq!(storm.layers[0].types.cumulonimbus, 1.0);
+    assert_eq!(storm.layers[2].types.stratocumulus, 1.0, "BKN250 is cirrus");
+}
