@@ -251,9 +251,10 @@ impl Cursor<'_, '_> {
     }
 }
 
+/// Whether a group is of one kind.
+type Recognizer = fn(&str) -> bool;
 /// Every kind of group after the observation time, by name, for telling a group out of place
 /// from one that is not a group at all.
-type Recognizer = fn(&str) -> bool;
 const GROUP_KINDS: [(&str, Recognizer); 9] = [
     ("wind", |g| wind(g).is_some()),
     ("wind variation", |g| wind_variation(g).is_some()),
