@@ -14,14 +14,16 @@
 mod camera;
 #[cfg(feature = "gif")]
 mod preview;
+mod solar;
 mod spline;
 mod sun;
 
 pub use camera::{Aim, CameraPose, camera_at, unwrap_yaw_deg};
 #[cfg(feature = "gif")]
 pub use preview::{GifPreview, PreviewError, preview_size};
+pub use solar::{declination_rad, solar_direction, solar_position};
 pub use spline::{SplineValue, catmull_rom, velocity_at_key};
-pub use sun::{SunAngles, sun_at};
+pub use sun::{SunAngles, key_direction, sun_at};
 
 use crate::scene::{Animation, CoverageKey, Scene};
 
@@ -39,7 +41,11 @@ pub fn scene_at(scene: &Scene, time_s: f32) -> Scene {
     if let Some(pose) = camera_at(&animation.camera_path, time_s) {
         pose.apply_to(&mut still.camera);
     }
-    if let Some(sun) = sun_at(&animation.time_of_day, time_s) {
+    if let Some(sun) = sun_at(
+        &animation.time_of_day,
+        scene.sun.time_of_day.as_ref(),
+        time_s,
+    ) {
         sun.apply_to(&mut still.sun);
     }
     if let Some(scale) = coverage_scale_at(&animation.coverage_scale, time_s) {
@@ -82,11 +88,7 @@ mod tests {
             yaw_deg: 90.0,
             pitch_deg: 5.0,
         };
-        let sun = |time_s, sun_elevation_deg| SunKey {
-            time_s,
-            sun_elevation_deg,
-            sun_azimuth_deg: 180.0,
-        };
+        let sun = |time_s, sun_elevation_deg| SunKey::at_angles(time_s, sun_elevation_deg, 180.0);
         let mut scene = Scene::default();
         scene.camera.look_at_m = Some([0.0, 2000.0, -5000.0]);
         scene.animation = Animation {

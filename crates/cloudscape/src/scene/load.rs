@@ -8,13 +8,17 @@ use toml::Spanned;
 use toml::de::{DeTable, Deserializer};
 
 use super::source_map::SourceMap;
-use super::{Scene, SceneError, key_path, locate, overrides, validate};
+use super::{Scene, SceneError, derive, key_path, locate, overrides, validate};
 
-/// Builds the scene described by `sources`: the file with its overrides applied, checked.
+/// Builds the scene described by `sources`: the file with its overrides applied, checked, and
+/// the values it derives from others (layers from a METAR report, the sun from the time of day)
+/// filled in.
 pub(super) fn scene(sources: &SourceMap) -> Result<Scene, SceneError> {
-    document(sources, |scene| {
-        validate::validate(scene).map_err(|v| (v.key, v.message))
-    })
+    let root = merged_document(sources)?;
+    let mut scene: Scene = deserialize(&root, sources)?;
+    validate::validate(&scene).map_err(|v| error_at(Some(&root), sources, &v.key, v.message))?;
+    derive::derive(&mut scene, &root, sources)?;
+    Ok(scene)
 }
 
 /// Builds the `T` that `sources` describe, checked by `check` (which names the dotted key of the

@@ -22,6 +22,16 @@ pub(super) fn span_of(root: &DeTable<'_>, path: &[String]) -> Option<Range<usize
     Some(node.span())
 }
 
+/// The span of the value at `path` when the document gives it (no fallback to a table above).
+pub(super) fn given_span(root: &DeTable<'_>, path: &[&str]) -> Option<Range<usize>> {
+    let (first, rest) = path.split_first()?;
+    let mut node = root.get(*first)?;
+    for segment in rest {
+        node = child(node.get_ref(), segment)?;
+    }
+    Some(node.span())
+}
+
 /// The key path of the deepest key or value whose span contains `span`.
 pub(super) fn path_at(root: &DeTable<'_>, span: &Range<usize>) -> Option<String> {
     let mut best: Option<Vec<String>> = None;

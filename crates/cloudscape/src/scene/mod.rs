@@ -5,10 +5,12 @@
 //! reads a file, applies `--set key.path=value` overrides, deserialises and validates, and reports
 //! every problem as a [`SceneError`] naming the file, line, column, key and what is allowed.
 
+mod derive;
 mod error;
 mod key_path;
 mod load;
 mod locate;
+pub mod metar;
 mod model;
 mod overrides;
 mod source_map;

@@ -124,6 +124,23 @@ pub struct Sun {
     pub color: [f32; 3],
     /// Angular radius of the disc in degrees, 0..5; 0.2679 deg is the real sun (Bruneton 2017).
     pub angular_radius_deg: f32,
+    /// When set, the sun's place from the local solar time, latitude and day of the year: it sets
+    /// `elevation_deg` and `azimuth_deg`, which the file must then leave out.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_of_day: Option<TimeOfDay>,
+}
+
+/// A moment and a place on Earth, which put the sun on the sky (see
+/// [`crate::animation::solar_position`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeOfDay {
+    /// Local solar time in hours, 0..24: 12 is solar noon, when the sun crosses the meridian.
+    pub solar_time_h: f32,
+    /// Latitude of the place in degrees, -90..90, north positive.
+    pub latitude_deg: f32,
+    /// Day of the year, 1..366 (1 is 1 January).
+    pub day_of_year: u32,
 }
 
 impl Default for Sun {
@@ -134,6 +151,7 @@ impl Default for Sun {
             irradiance: 8.0,
             color: [1.0, 1.0, 1.0],
             angular_radius_deg: 0.2679,
+            time_of_day: None,
         }
     }
 }
@@ -354,6 +372,9 @@ pub struct WeatherMap {
     pub feature_size_km: f32,
     /// PNG file for `source = "file"`, relative to the scene file.
     pub path: Option<String>,
+    /// A METAR weather report (WMO FM 15) that builds the scene's cloud layers and haze (see
+    /// [`crate::scene::metar`]); the file must then give no `layers` and no `sky.visibility_m`.
+    pub metar: Option<String>,
 }
 
 impl Default for WeatherMap {
@@ -365,6 +386,7 @@ impl Default for WeatherMap {
             resolution: 512,
             feature_size_km: 6.0,
             path: None,
+            metar: None,
         }
     }
 }
@@ -813,7 +835,7 @@ pub struct Animation {
     /// Camera keyframes: position, and orientation by look-at point or by yaw and pitch.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub camera_path: Vec<CameraKey>,
-    /// Sun keyframes: elevation and azimuth.
+    /// Sun keyframes: elevation and azimuth, or local solar time.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub time_of_day: Vec<SunKey>,
     /// Keyframes of a factor on every layer's coverage: clouds grow (> 1) and decay (< 1).
@@ -848,17 +870,46 @@ pub struct CameraKey {
     pub pitch_deg: f32,
 }
 
-/// One keyframe of the sun's path over the sky.
+/// One keyframe of the sun's path over the sky: by elevation and azimuth, or by local solar time
+/// (at the latitude and day of `sun.time_of_day`), one or the other. Between two solar-time
+/// keyframes the sun follows its true course over the sky.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SunKey {
     /// Scene time of the keyframe, seconds; later than the previous keyframe's.
     pub time_s: f32,
-    /// Sun elevation above the horizon in degrees, -90..90.
-    pub sun_elevation_deg: f32,
+    /// Sun elevation above the horizon in degrees, -90..90; given with `sun_azimuth_deg`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sun_elevation_deg: Option<f32>,
     /// Sun azimuth in degrees clockwise from north; less than 90 degrees of sky from the previous
-    /// keyframe's sun.
-    pub sun_azimuth_deg: f32,
+    /// keyframe's sun unless both are given by solar time.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sun_azimuth_deg: Option<f32>,
+    /// Local solar time in hours, 0..24, instead of the two angles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub solar_time_h: Option<f32>,
+}
+
+impl SunKey {
+    /// A keyframe that puts the sun at `elevation_deg` and `azimuth_deg` at `time_s`.
+    pub fn at_angles(time_s: f32, elevation_deg: f32, azimuth_deg: f32) -> SunKey {
+        SunKey {
+            time_s,
+            sun_elevation_deg: Some(elevation_deg),
+            sun_azimuth_deg: Some(azimuth_deg),
+            solar_time_h: None,
+        }
+    }
+
+    /// A keyframe that puts the sun where it is at local solar time `solar_time_h` at `time_s`.
+    pub fn at_solar_time(time_s: f32, solar_time_h: f32) -> SunKey {
+        SunKey {
+            time_s,
+            sun_elevation_deg: None,
+            sun_azimuth_deg: None,
+            solar_time_h: Some(solar_time_h),
+        }
+    }
 }
 
 /// One keyframe of the coverage factor.

@@ -66,6 +66,14 @@ impl SourceMap {
         self.overrides.iter().map(|o| (o.text.as_str(), o.start))
     }
 
+    /// The text at `span` of the shared address space, when one text holds all of it.
+    pub(super) fn text_at(&self, span: &Range<usize>) -> Option<&str> {
+        std::iter::once(&self.file)
+            .chain(&self.overrides)
+            .find(|t| t.contains(span.start))
+            .and_then(|t| t.text.get(span.start - t.start..span.end - t.start))
+    }
+
     /// An error in the `index`th override as a whole (e.g. a malformed `key=value`), not at a span.
     pub(super) fn override_error(
         &self,

@@ -5,6 +5,8 @@
 
 use std::fmt;
 
+use crate::animation::key_direction;
+
 use super::model::{
     CameraKey, CloudLayer, CoverageKey, Scene, SpriteBoxSpec, SpriteCloudSpec, SunKey, VolumeGrid,
     WeatherSource,
@@ -68,6 +70,7 @@ fn validate_animation(scene: &Scene) -> Result<(), Violation> {
         &CAMERA_PATH,
     )?;
     check_path(&animation.time_of_day, "animation.time_of_day", &SUN_PATH)?;
+    validate_sun_path(scene)?;
     check_path(
         &animation.coverage_scale,
         "animation.coverage_scale",
@@ -126,6 +129,10 @@ enum Field<'a> {
 
 fn optional_floats<const N: usize>(value: &Option<[f32; N]>) -> Field<'_> {
     value.as_ref().map_or(Field::Absent, |v| Field::Floats(v))
+}
+
+fn optional_float(value: Option<f32>) -> Field<'static> {
+    value.map_or(Field::Absent, Field::Float)
 }
 
 fn optional_int(value: Option<u32>) -> Field<'static> {
@@ -221,6 +228,9 @@ const SCENE_RULES: &[Rule<Scene>] = &[
     rule("sun.irradiance", AtLeast(0.0), "", |s| Float(s.sun.irradiance)),
     rule("sun.color", Between(0.0, 1.0), "", |s| Floats(&s.sun.color)),
     rule("sun.angular_radius_deg", Between(0.0, 5.0), "deg", |s| Float(s.sun.angular_radius_deg)),
+    rule("sun.time_of_day.solar_time_h", Between(0.0, 24.0), "h", |s| optional_float(s.sun.time_of_day.as_ref().map(|t| t.solar_time_h))),
+    rule("sun.time_of_day.latitude_deg", Between(-90.0, 90.0), "deg", |s| optional_float(s.sun.time_of_day.as_ref().map(|t| t.latitude_deg))),
+    rule("sun.time_of_day.day_of_year", Between(1.0, 366.0), "", |s| optional_int(s.sun.time_of_day.as_ref().map(|t| t.day_of_year))),
     rule("sky.radiance", AtLeast(0.0), "", |s| Floats(&s.sky.radiance)),
     rule("sky.zenith_radiance", AtLeast(0.0), "", |s| Floats(&s.sky.zenith_radiance)),
     rule("sky.horizon_radiance", AtLeast(0.0), "", |s| Floats(&s.sky.horizon_radiance)),
@@ -325,8 +335,9 @@ const CAMERA_KEY_RULES: &[Rule<CameraKey>] = &[
 #[rustfmt::skip]
 const SUN_KEY_RULES: &[Rule<SunKey>] = &[
     rule("time_s", Finite, "s", |k| Float(k.time_s)),
-    rule("sun_elevation_deg", Between(-90.0, 90.0), "deg", |k| Float(k.sun_elevation_deg)),
-    rule("sun_azimuth_deg", Finite, "deg", |k| Float(k.sun_azimuth_deg)),
+    rule("sun_elevation_deg", Between(-90.0, 90.0), "deg", |k| optional_float(k.sun_elevation_deg)),
+    rule("sun_azimuth_deg", Finite, "deg", |k| optional_float(k.sun_azimuth_deg)),
+    rule("solar_time_h", Between(0.0, 24.0), "h", |k| optional_float(k.solar_time_h)),
 ];
 
 #[rustfmt::skip]
@@ -348,11 +359,12 @@ const CAMERA_PATH: PathRules<CameraKey> = PathRules {
 #[rustfmt::skip]
 const SUN_PATH: PathRules<SunKey> = PathRules {
     rules: SUN_KEY_RULES,
-    relations: &[],
-    pairs: &[
-        PairRelation { key: "time_s", broken: time_not_increasing },
-        PairRelation { key: "sun_azimuth_deg", broken: sun_keys_too_far_apart },
+    relations: &[
+        Relation { key: "solar_time_h", broken: sun_key_given_both_ways },
+        Relation { key: "sun_azimuth_deg", broken: sun_key_has_one_angle },
+        Relation { key: "time_s", broken: sun_key_has_no_place },
     ],
+    pairs: &[PairRelation { key: "time_s", broken: time_not_increasing }],
 };
 
 #[rustfmt::skip]
@@ -501,30 +513,78 @@ fn look_at_on_some_keys_only(previous: &CameraKey, key: &CameraKey) -> Option<St
     })
 }
 
-/// Cosine of the angle on the sky between two sun keyframes, by the spherical law of cosines:
-/// `sin e1 sin e2 + cos e1 cos e2 cos(a1 - a2)`.
-fn cos_angle_between(a: &SunKey, b: &SunKey) -> f32 {
-    let (e1, e2) = (
-        a.sun_elevation_deg.to_radians(),
-        b.sun_elevation_deg.to_radians(),
-    );
-    let azimuth_difference = (a.sun_azimuth_deg - b.sun_azimuth_deg).to_radians();
-    e1.sin() * e2.sin() + e1.cos() * e2.cos() * azimuth_difference.cos()
+fn sun_key_given_both_ways(key: &SunKey) -> Option<String> {
+    let angles = key.sun_elevation_deg.is_some() || key.sun_azimuth_deg.is_some();
+    (angles && key.solar_time_h.is_some()).then(|| {
+        "this keyframe gives both solar_time_h and sun angles; keep one: solar_time_h, or \
+         sun_elevation_deg and sun_azimuth_deg"
+            .to_string()
+    })
 }
 
-/// Sun directions are interpolated as vectors (see `crate::animation`), which needs neighbours
-/// less than 90 degrees apart.
-fn sun_keys_too_far_apart(previous: &SunKey, key: &SunKey) -> Option<String> {
-    let angle_deg = cos_angle_between(previous, key)
-        .clamp(-1.0, 1.0)
-        .acos()
-        .to_degrees();
-    (angle_deg >= 90.0).then(|| {
-        format!(
-            "the sun moves {angle_deg:.1} deg across the sky from the previous keyframe; allowed \
-             < 90 deg: add a keyframe in between"
-        )
+fn sun_key_has_one_angle(key: &SunKey) -> Option<String> {
+    (key.sun_elevation_deg.is_some() != key.sun_azimuth_deg.is_some()).then(|| {
+        "give sun_elevation_deg and sun_azimuth_deg together (or solar_time_h instead)".to_string()
     })
+}
+
+fn sun_key_has_no_place(key: &SunKey) -> Option<String> {
+    let none = key.sun_elevation_deg.is_none()
+        && key.sun_azimuth_deg.is_none()
+        && key.solar_time_h.is_none();
+    none.then(|| {
+        "this keyframe puts the sun nowhere: give sun_elevation_deg and sun_azimuth_deg, or \
+         solar_time_h"
+            .to_string()
+    })
+}
+
+/// Checks what the sun path needs of the rest of the scene: solar-time keyframes need
+/// `sun.time_of_day` (its latitude and day), and neighbouring keyframes, which are interpolated
+/// as vectors (see `crate::animation`), must be less than 90 degrees of sky apart, except two
+/// solar-time keyframes, between which the path traces the sun's course.
+fn validate_sun_path(scene: &Scene) -> Result<(), Violation> {
+    let day = scene.sun.time_of_day.as_ref();
+    let keys = &scene.animation.time_of_day;
+    let field = |key: &SunKey| {
+        if key.solar_time_h.is_some() {
+            "solar_time_h"
+        } else {
+            "sun_azimuth_deg"
+        }
+    };
+    let violation = |index: usize, message: String| Violation {
+        key: format!("animation.time_of_day.{index}.{}", field(&keys[index])),
+        message,
+    };
+    if let (Some(index), None) = (keys.iter().position(|k| k.solar_time_h.is_some()), day) {
+        return Err(violation(
+            index,
+            "a keyframe by solar time needs [sun] time_of_day = { solar_time_h, latitude_deg, \
+             day_of_year } for its latitude and day"
+                .to_string(),
+        ));
+    }
+    for (index, pair) in keys.windows(2).enumerate() {
+        if pair[0].solar_time_h.is_some() && pair[1].solar_time_h.is_some() {
+            continue;
+        }
+        let directions = key_direction(&pair[0], day).zip(key_direction(&pair[1], day));
+        let Some((before, after)) = directions else {
+            continue;
+        };
+        let angle_deg = before.dot(after).clamp(-1.0, 1.0).acos().to_degrees();
+        if angle_deg >= 90.0 {
+            return Err(violation(
+                index + 1,
+                format!(
+                    "the sun moves {angle_deg:.1} deg across the sky from the previous keyframe; \
+                     allowed < 90 deg: add a keyframe in between"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Checks every keyframe of `keys` (dotted path `path`), that there are none or at least 2, and
@@ -618,7 +678,7 @@ impl<T> Rule<T> {
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
-    use crate::scene::model::{Animation, VolumeGrid};
+    use crate::scene::model::{Animation, TimeOfDay, VolumeGrid};
 
     /// Two camera keyframes 10 s apart that look at a point, two sun and two coverage keyframes.
     pub(in crate::scene) fn two_key_animation() -> Animation {
@@ -629,11 +689,7 @@ pub(super) mod tests {
             yaw_deg: 0.0,
             pitch_deg: 0.0,
         };
-        let sun = |time_s, sun_azimuth_deg| SunKey {
-            time_s,
-            sun_elevation_deg: 30.0,
-            sun_azimuth_deg,
-        };
+        let sun = |time_s, sun_azimuth_deg| SunKey::at_angles(time_s, 30.0, sun_azimuth_deg);
         let coverage = |time_s, scale| CoverageKey { time_s, scale };
         Animation {
             camera_path: vec![camera(0.0, 0.0), camera(10.0, 500.0)],
@@ -677,6 +733,16 @@ pub(super) mod tests {
             ]),
         });
         scene.animation = two_key_animation();
+        scene.sun.time_of_day = Some(TimeOfDay {
+            solar_time_h: 15.0,
+            latitude_deg: 51.5,
+            day_of_year: 172,
+        });
+        scene
+            .animation
+            .time_of_day
+            .push(SunKey::at_solar_time(20.0, 15.0));
+        scene.weather.metar = Some("EGLL 011750Z 24012KT 9999 FEW012 SCT030 18/12 Q1012".into());
         scene
     }
 
@@ -844,7 +910,7 @@ pub(super) mod tests {
                 "animation.camera_path.0.look_at_m",
             ),
             (
-                |a| a.time_of_day[1].sun_azimuth_deg = 35.0,
+                |a| a.time_of_day[1].sun_azimuth_deg = Some(35.0),
                 "animation.time_of_day.1.sun_azimuth_deg",
             ),
         ];
@@ -856,9 +922,65 @@ pub(super) mod tests {
     #[test]
     fn sun_keyframes_just_under_90_degrees_apart_are_allowed() {
         let mut scene = animated_scene();
-        scene.animation.time_of_day[0].sun_elevation_deg = 0.0;
-        scene.animation.time_of_day[1].sun_elevation_deg = 0.0;
-        scene.animation.time_of_day[1].sun_azimuth_deg = 215.0 + 89.5;
+        scene.animation.time_of_day[0] = SunKey::at_angles(0.0, 0.0, 215.0);
+        scene.animation.time_of_day[1] = SunKey::at_angles(10.0, 0.0, 215.0 + 89.5);
         validate(&scene).unwrap();
+    }
+
+    #[test]
+    fn sun_keyframes_are_given_one_way_or_the_other() {
+        type Breaker = fn(&mut Animation);
+        let cases: [(Breaker, &str, &str); 4] = [
+            (
+                |a| a.time_of_day[1].solar_time_h = Some(14.0),
+                "solar_time_h",
+                "keep one",
+            ),
+            (
+                |a| a.time_of_day[1].sun_elevation_deg = None,
+                "sun_azimuth_deg",
+                "together",
+            ),
+            (
+                |a| {
+                    a.time_of_day[1] = SunKey {
+                        solar_time_h: None,
+                        ..SunKey::at_solar_time(10.0, 0.0)
+                    }
+                },
+                "time_s",
+                "nowhere",
+            ),
+            (
+                |a| a.time_of_day[1] = SunKey::at_solar_time(10.0, 14.0),
+                "solar_time_h",
+                "sun.time_of_day",
+            ),
+        ];
+        for (break_it, key, words) in cases {
+            let violation = animation_violation(break_it);
+            assert_eq!(violation.key, format!("animation.time_of_day.1.{key}"));
+            assert!(
+                violation.message.contains(words) || violation.message.contains("time_of_day ="),
+                "{}",
+                violation.message
+            );
+        }
+    }
+
+    #[test]
+    fn solar_time_keyframes_may_span_the_day_and_others_stay_within_90_degrees() {
+        let mut scene = fully_populated();
+        let day = [6.0, 12.0, 18.0].map(|h| SunKey::at_solar_time(h * 10.0, h));
+        scene.animation.time_of_day = day.to_vec();
+        validate(&scene).unwrap();
+        scene.animation.time_of_day[2] = SunKey::at_angles(180.0, 5.0, 30.0);
+        let violation = validate(&scene).unwrap_err();
+        assert_eq!(violation.key, "animation.time_of_day.2.sun_azimuth_deg");
+        assert!(
+            violation.message.contains("90 deg"),
+            "{}",
+            violation.message
+        );
     }
 }

@@ -174,11 +174,7 @@ mod tests {
 
     #[test]
     fn frames_span_the_animation_evenly() {
-        let key = |time_s| cloudscape::scene::SunKey {
-            time_s,
-            sun_elevation_deg: 30.0,
-            sun_azimuth_deg: 180.0,
-        };
+        let key = |time_s| cloudscape::scene::SunKey::at_angles(time_s, 30.0, 180.0);
         let mut scene = Scene::default();
         scene.animation.time_of_day = vec![key(1.0), key(3.0)];
         assert_eq!(frame_times_s(&scene, 5).unwrap(), [1.0, 1.5, 2.0, 2.5, 3.0]);
