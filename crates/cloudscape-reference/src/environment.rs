@@ -5,8 +5,8 @@ use crate::geometry::{ground_distance, up};
 use crate::sampling::{
     UNIFORM_HEMISPHERE_PDF, UNIFORM_SPHERE_PDF, uniform_hemisphere, uniform_sphere,
 };
-use cloudscape::environment::{SkyModel, SkyRadiance, ViewedEnvironment};
 pub use cloudscape::environment::SunDisc;
+use cloudscape::environment::{SkyModel, SkyRadiance, ViewedEnvironment};
 use cloudscape::field::PlanetGeometry;
 use cloudscape::frame::Frame;
 use glam::{Vec2, Vec3};
@@ -72,8 +72,9 @@ impl Environment {
 
     /// Radiance of the sun's disc seen from `p` along `dir` (zero outside it).
     pub fn sun_disc_radiance(&self, p: Vec3, dir: Vec3) -> Vec3 {
-        self.sun
-            .map_or(Vec3::ZERO, |sun| sun.radiance_of(self.sun_irradiance(p), dir))
+        self.sun.map_or(Vec3::ZERO, |sun| {
+            sun.radiance_of(self.sun_irradiance(p), dir)
+        })
     }
 
     /// Distance to the ground along the ray, infinite without a ground or when it is missed.

@@ -169,7 +169,10 @@ fn atmosphere_constants(put: &mut impl FnMut(String)) {
         ("AERIAL_STEPS_PER_SLICE", l::AERIAL_STEPS_PER_SLICE),
         ("TRANSMITTANCE_STEPS", l::TRANSMITTANCE_STEPS),
         ("MULTIPLE_SCATTERING_STEPS", l::MULTIPLE_SCATTERING_STEPS),
-        ("MULTIPLE_SCATTERING_DIRECTIONS", l::MULTIPLE_SCATTERING_DIRECTIONS),
+        (
+            "MULTIPLE_SCATTERING_DIRECTIONS",
+            l::MULTIPLE_SCATTERING_DIRECTIONS,
+        ),
         ("SKY_VIEW_STEPS", l::SKY_VIEW_STEPS),
         ("IRRADIANCE_STEPS", l::IRRADIANCE_STEPS),
         ("IRRADIANCE_DIRECTIONS", l::IRRADIANCE_DIRECTIONS),
@@ -182,6 +185,7 @@ fn atmosphere_constants(put: &mut impl FnMut(String)) {
         ("MULTIPLE_SCATTERING_SIZE", l::MULTIPLE_SCATTERING_SIZE),
         ("IRRADIANCE_SIZE", l::IRRADIANCE_SIZE),
         ("SKY_VIEW_SIZE", l::SKY_VIEW_SIZE),
+        ("AERIAL_SIZE", l::AERIAL_SIZE),
     ];
     for (name, (w, h)) in sizes {
         put(format!("const ATMOSPHERE_{name} = vec2<u32>({w}u, {h}u);"));

@@ -4,7 +4,6 @@
 //! GPU without regenerating the noise.
 
 use cloudscape::environment::{Environment, ViewedEnvironment};
-use cloudscape::scene::SkyModel;
 use cloudscape::frame::{DepthConvention, Frame};
 use cloudscape::gpu::GpuContext;
 use cloudscape::optics::{PhaseLobes, diffuse_transmittance};
@@ -12,6 +11,7 @@ use cloudscape::post::tonemap;
 use cloudscape::probe::{Probe, ProbeFunction, ProbeInput};
 use cloudscape::renderer::{CloudRenderer, Reuse};
 use cloudscape::scene::Scene;
+use cloudscape::scene::SkyModel;
 use glam::{UVec2, Vec2, Vec3, Vec4};
 use std::path::Path;
 
@@ -311,13 +311,20 @@ fn assert_points(
     cpu: impl Fn(Vec3) -> Vec3,
     tolerance: f32,
 ) {
-    let inputs: Vec<ProbeInput> = points.iter().map(|p| input(p.extend(0.0), Vec4::ZERO)).collect();
+    let inputs: Vec<ProbeInput> = points
+        .iter()
+        .map(|p| input(p.extend(0.0), Vec4::ZERO))
+        .collect();
     let got = gpu(ctx, clouds, f, &inputs);
     let want: Vec<Vec3> = points.iter().map(|p| cpu(*p)).collect();
     let scale = want.iter().map(|w| w.max_element()).fold(0.0, f32::max);
     for (i, (g, w)) in got.iter().zip(&want).enumerate() {
         let error = (g.truncate() - *w).abs().max_element() / scale;
-        assert!(error <= tolerance, "{f:?} #{i} at {}: GPU {g} vs CPU {w}", points[i]);
+        assert!(
+            error <= tolerance,
+            "{f:?} #{i} at {}: GPU {g} vs CPU {w}",
+            points[i]
+        );
     }
 }
 
@@ -336,14 +343,44 @@ fn atmosphere_functions_match_the_cpu() {
     let clouds = renderer(&ctx, &scene, &frame);
     let env = ViewedEnvironment::new(&Environment::from_scene(&scene), frame.camera_position_m);
     let points: Vec<Vec3> = (0..40)
-        .map(|i| Vec3::new(9000.0 * unit(i, 20) - 4500.0, 12_000.0 * unit(i, 21), 9000.0 * unit(i, 22)))
+        .map(|i| {
+            Vec3::new(
+                9000.0 * unit(i, 20) - 4500.0,
+                12_000.0 * unit(i, 21),
+                9000.0 * unit(i, 22),
+            )
+        })
         .collect();
     let probe = (&ctx, &clouds);
-    assert_points(probe, ProbeFunction::SunIrradiance, &points, |p| env.sun_irradiance(p), 0.02);
-    assert_points(probe, ProbeFunction::SkyIrradianceUp, &points, |p| env.sky_irradiance_up(p), 0.02);
-    assert_points(probe, ProbeFunction::SkyMeanRadianceUp, &points, |p| env.sky_mean_radiance_up(p), 0.02);
+    assert_points(
+        probe,
+        ProbeFunction::SunIrradiance,
+        &points,
+        |p| env.sun_irradiance(p),
+        0.02,
+    );
+    assert_points(
+        probe,
+        ProbeFunction::SkyIrradianceUp,
+        &points,
+        |p| env.sky_irradiance_up(p),
+        0.02,
+    );
+    assert_points(
+        probe,
+        ProbeFunction::SkyMeanRadianceUp,
+        &points,
+        |p| env.sky_mean_radiance_up(p),
+        0.02,
+    );
     let (dirs, _) = sky_directions(env.env.sun);
-    assert_points(probe, ProbeFunction::SkyRadiance, &dirs, |d| env.sky_radiance(d), 0.02);
+    assert_points(
+        probe,
+        ProbeFunction::SkyRadiance,
+        &dirs,
+        |d| env.sky_radiance(d),
+        0.02,
+    );
     let disc: Vec<Vec3> = dirs.iter().step_by(2).copied().collect();
     let limb = |d| env.sun_disc_radiance(d);
     assert_points(probe, ProbeFunction::SunDiscRadiance, &disc, limb, 0.02);
@@ -386,16 +423,39 @@ fn the_cloud_shadow_map_matches_the_cpu() {
     let map = CloudShadowMap::build(clouds.field(), params, sun, (48, frame.time_s));
     let points: Vec<Vec3> = (0..200)
         .map(|i| {
-            let y = if i % 2 == 0 { 0.0 } else { 3000.0 * unit(i, 31) };
-            Vec3::new(30_000.0 * unit(i, 32) - 15_000.0, y, 30_000.0 * unit(i, 33) - 15_000.0)
+            let y = if i % 2 == 0 {
+                0.0
+            } else {
+                3000.0 * unit(i, 31)
+            };
+            Vec3::new(
+                30_000.0 * unit(i, 32) - 15_000.0,
+                y,
+                30_000.0 * unit(i, 33) - 15_000.0,
+            )
         })
         .collect();
     let probe = (&ctx, &clouds);
     let sun_depth = |p| Vec3::splat(map.optical_depth(p, 0));
-    assert_points(probe, ProbeFunction::CloudSunOpticalDepth, &points, sun_depth, 0.02);
+    assert_points(
+        probe,
+        ProbeFunction::CloudSunOpticalDepth,
+        &points,
+        sun_depth,
+        0.02,
+    );
     let sky_depth = |p| Vec3::splat(map.optical_depth(p, 1));
-    assert_points(probe, ProbeFunction::CloudSkyOpticalDepth, &points, sky_depth, 0.02);
-    assert!(points.iter().filter(|p| sun_depth(**p).x > 1.0).count() > 20, "clouds cast shadows");
+    assert_points(
+        probe,
+        ProbeFunction::CloudSkyOpticalDepth,
+        &points,
+        sky_depth,
+        0.02,
+    );
+    assert!(
+        points.iter().filter(|p| sun_depth(**p).x > 1.0).count() > 20,
+        "clouds cast shadows"
+    );
 }
 
 /// A CPU tone-mapping function.

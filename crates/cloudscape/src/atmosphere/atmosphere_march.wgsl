@@ -5,7 +5,9 @@
 // Light scattered toward the start of `ray` over `span` and the transmittance over it, from
 // `steps` samples spaced evenly or quadratically: SkyTables::scattered_along. When
 // `world.shadowed`, the sun's single scattering at world point `world.origin + world.dir * t` is
-// dimmed by the clouds' diffuse transmittance toward the sun, from the shared map (light shafts).
+// dimmed by the clouds' direct-beam transmittance exp(-tau) toward the sun, from the shared map:
+// light shafts. (The light the clouds scatter forward is diffuse, not in the sun's direction, so
+// the sun's phase function does not apply to it; the air's multiple scattering stays unshadowed.)
 struct ScatteredLight {
     radiance: vec3<f32>,
     transmittance: vec3<f32>,
@@ -37,7 +39,7 @@ fn atmosphere_scattered_along(ray: LocalRay, span: vec2<f32>, steps: u32, quadra
         let sample = atmosphere_at(air, r);
         var sun = environment_table_sun_transmittance(r, mu_s);
         if world.shadowed == 1u {
-            sun *= environment_cloud_sun_visibility(world.origin + world.dir * t);
+            sun *= environment_cloud_sun_transmittance(world.origin + world.dir * t);
         }
         let single = sample.rayleigh_scattering * rayleigh_phase + vec3<f32>(sample.mie_scattering * mie_phase);
         let scattering = sample.rayleigh_scattering + vec3<f32>(sample.mie_scattering);

@@ -3,12 +3,14 @@
 //! [`crate::environment::EnvironmentGpu`] binds.
 
 use super::Air;
-use super::luts::{IRRADIANCE_SIZE, MULTIPLE_SCATTERING_SIZE, SKY_VIEW_SIZE, TRANSMITTANCE_SIZE};
-use crate::environment::{AERIAL_SIZE, EnvironmentTable, TablePass};
+use super::luts::{
+    AERIAL_SIZE, IRRADIANCE_SIZE, MULTIPLE_SCATTERING_SIZE, SKY_VIEW_SIZE, TRANSMITTANCE_SIZE,
+};
+use crate::environment::{EnvironmentTable, TablePass};
 use crate::frame::Shared;
 use crate::gpu::{GpuContext, PassTimer};
 use glam::UVec2;
-use wgpu::TextureViewDimension::{D2, D3};
+use wgpu::TextureViewDimension::D2;
 
 /// Labels of the passes that run when the air changes, in order.
 pub const TABLE_PASS_NAMES: [&str; 3] = [
@@ -37,7 +39,13 @@ impl AtmospherePasses {
     /// Builds the pipelines against the shared groups.
     pub fn new(ctx: &GpuContext, shared: &Shared) -> AtmospherePasses {
         let luts = |entry, label, table, outputs: &[wgpu::TextureViewDimension]| {
-            TablePass::new(ctx, shared, ("atmosphere_luts", entry), (label, table), outputs)
+            TablePass::new(
+                ctx,
+                shared,
+                ("atmosphere_luts", entry),
+                (label, table),
+                outputs,
+            )
         };
         let [t, ms, irr] = TABLE_PASS_NAMES;
         let [view, aerial] = FRAME_PASS_NAMES;
@@ -71,7 +79,7 @@ impl AtmospherePasses {
                 shared,
                 ("atmosphere_aerial", "atmosphere_build_aerial"),
                 (aerial, EnvironmentTable::Aerial),
-                &[D3, D3],
+                &[D2, D2],
             ),
             filled_for: None,
         }

@@ -21,6 +21,8 @@ pub const MULTIPLE_SCATTERING_SIZE: (u32, u32) = (32, 32);
 pub const IRRADIANCE_SIZE: (u32, u32) = (32, 32);
 /// Sky-view table size: azimuth from the sun across, elevation down (Hillaire 2020).
 pub const SKY_VIEW_SIZE: (u32, u32) = (192, 108);
+/// Columns and rows of the aerial-perspective volume across the view (Hillaire 2020: 32 x 32).
+pub const AERIAL_SIZE: (u32, u32) = (32, 32);
 /// Depth of one aerial-perspective slice, metres (Hillaire 2020: 32 slices of 4 km).
 pub const AERIAL_SLICE_M: f32 = 4_000.0;
 /// Number of aerial-perspective slices (Hillaire 2020).
@@ -106,9 +108,15 @@ fn horizon_elevation(air: &Air, r: f32) -> f32 {
 pub fn sky_view_uv(air: &Air, r: f32, elevation: f32, azimuth: f32) -> Vec2 {
     let horizon = horizon_elevation(air, r);
     let v = if elevation >= horizon {
-        0.5 + 0.5 * ((elevation - horizon) / (FRAC_PI_2 - horizon)).clamp(0.0, 1.0).sqrt()
+        0.5 + 0.5
+            * ((elevation - horizon) / (FRAC_PI_2 - horizon))
+                .clamp(0.0, 1.0)
+                .sqrt()
     } else {
-        0.5 - 0.5 * ((horizon - elevation) / (horizon + FRAC_PI_2)).clamp(0.0, 1.0).sqrt()
+        0.5 - 0.5
+            * ((horizon - elevation) / (horizon + FRAC_PI_2))
+                .clamp(0.0, 1.0)
+                .sqrt()
     };
     Vec2::new(
         texture_coord((azimuth / PI).clamp(0.0, 1.0), SKY_VIEW_SIZE.0),
@@ -297,8 +305,7 @@ impl SkyTables {
             let sun = self.sun_transmittance(r, mu_s) * sun_visibility(t);
             let single = sample.rayleigh_scattering * rayleigh_phase
                 + Vec3::splat(sample.mie_scattering * mie_phase);
-            let source =
-                single * sun + self.multiple_scattering(r, mu_s) * sample.scattering();
+            let source = single * sun + self.multiple_scattering(r, mu_s) * sample.scattering();
             let step = (-sample.extinction * (t1 - t0)).exp();
             let integral = (Vec3::ONE - step) / sample.extinction.max(Vec3::splat(1e-12));
             light += through * source * integral;
@@ -348,7 +355,10 @@ impl SkyTables {
             let (r, mu_s) = sun_table_r_mu(&self.air, uv, IRRADIANCE_SIZE);
             self.irradiance_at(r, mu_s)
         };
-        [Table2::from_fn(w, h, |uv| at(uv)[0]), Table2::from_fn(w, h, |uv| at(uv)[1])]
+        [
+            Table2::from_fn(w, h, |uv| at(uv)[0]),
+            Table2::from_fn(w, h, |uv| at(uv)[1]),
+        ]
     }
 
     /// Irradiance on an upward surface at radius `r` and mean radiance over the hemisphere above

@@ -109,8 +109,7 @@ impl Air {
         let h = (r - self.bottom_radius_m).max(0.0);
         let rayleigh = (-h / RAYLEIGH_SCALE_HEIGHT_M).exp();
         let mie = (-h / MIE_SCALE_HEIGHT_M).exp();
-        let ozone =
-            (1.0 - (h - OZONE_PEAK_ALTITUDE_M).abs() / OZONE_HALF_WIDTH_M).max(0.0);
+        let ozone = (1.0 - (h - OZONE_PEAK_ALTITUDE_M).abs() / OZONE_HALF_WIDTH_M).max(0.0);
         let rayleigh_scattering = self.rayleigh_scattering_per_m * rayleigh;
         let mie_scattering = self.mie_scattering_per_m * mie;
         AirSample {
@@ -142,8 +141,7 @@ impl Air {
 
     /// Distance from radius `r` along a ray of cosine `mu` to the ground (the near intersection).
     pub fn distance_to_ground(&self, r: f32, mu: f32) -> f32 {
-        let discriminant =
-            r * r * (mu * mu - 1.0) + self.bottom_radius_m * self.bottom_radius_m;
+        let discriminant = r * r * (mu * mu - 1.0) + self.bottom_radius_m * self.bottom_radius_m;
         (-r * mu - discriminant.max(0.0).sqrt()).max(0.0)
     }
 
@@ -210,7 +208,10 @@ mod tests {
         scene.sky.visibility_m = 20_000.0;
         let air = Air::from_scene(&scene);
         let green = air.at(air.bottom_radius_m).extinction.y;
-        assert!((green * 20_000.0 - KOSCHMIEDER_CONTRAST).abs() < 1e-3, "{green}");
+        assert!(
+            (green * 20_000.0 - KOSCHMIEDER_CONTRAST).abs() < 1e-3,
+            "{green}"
+        );
         scene.sky.visibility_m = 10_000_000.0;
         let clear = Air::from_scene(&scene);
         assert_eq!(clear.mie_extinction_per_m, MIE_EXTINCTION_PER_M);

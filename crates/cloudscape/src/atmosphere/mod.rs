@@ -16,7 +16,7 @@ pub mod table;
 pub use medium::Air;
 
 use glam::Vec3;
-use luts::{LocalRay, SkyTables, sun_table_uv, IRRADIANCE_SIZE};
+use luts::{IRRADIANCE_SIZE, LocalRay, SkyTables, sun_table_uv};
 use std::sync::{Arc, Mutex};
 use table::Table2;
 
@@ -99,7 +99,8 @@ impl Atmosphere {
         sun_visibility: impl Fn(f32) -> f32,
     ) -> (Vec3, Vec3) {
         let ray = self.local_ray(p, dir, sun);
-        self.tables.aerial_perspective(ray, distance_m, sun_visibility)
+        self.tables
+            .aerial_perspective(ray, distance_m, sun_visibility)
     }
 }
 

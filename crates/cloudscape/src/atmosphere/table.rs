@@ -68,7 +68,10 @@ impl Table2 {
 
     /// The texels as RGBA `f32`, alpha 1, for upload.
     pub fn to_rgba(&self) -> Vec<[f32; 4]> {
-        self.texels.iter().map(|t| t.extend(1.0).to_array()).collect()
+        self.texels
+            .iter()
+            .map(|t| t.extend(1.0).to_array())
+            .collect()
     }
 }
 

@@ -28,9 +28,15 @@ fn zenith_transmittance_matches_the_vertical_optical_depth() {
 #[test]
 fn table_parameterisations_round_trip() {
     let air = air();
-    for (r, mu) in [(air.bottom_radius_m + 10.0, 0.3), (air.bottom_radius_m + 5e4, -0.2)] {
+    for (r, mu) in [
+        (air.bottom_radius_m + 10.0, 0.3),
+        (air.bottom_radius_m + 5e4, -0.2),
+    ] {
         let (r2, mu2) = transmittance_r_mu(&air, transmittance_uv(&air, r, mu));
-        assert!((r2 - r).abs() < 1.0 && (mu2 - mu).abs() < 1e-3, "{r2} {mu2}");
+        assert!(
+            (r2 - r).abs() < 1.0 && (mu2 - mu).abs() < 1e-3,
+            "{r2} {mu2}"
+        );
         let size = MULTIPLE_SCATTERING_SIZE;
         let (r3, mu3) = sun_table_r_mu(&air, sun_table_uv(&air, r, mu, size), size);
         assert!((r3 - r).abs() < 1.0 && (mu3 - mu).abs() < 1e-5);
@@ -38,7 +44,10 @@ fn table_parameterisations_round_trip() {
     let r = air.bottom_radius_m + 2000.0;
     for (elevation, azimuth) in [(0.7, 0.3), (-0.01, 2.0), (-1.2, 3.0), (0.0, 0.0)] {
         let (e, a) = sky_view_angles(&air, r, sky_view_uv(&air, r, elevation, azimuth));
-        assert!((e - elevation).abs() < 1e-3 && (a - azimuth).abs() < 1e-4, "{e} {a}");
+        assert!(
+            (e - elevation).abs() < 1e-3 && (a - azimuth).abs() < 1e-4,
+            "{e} {a}"
+        );
     }
 }
 
@@ -62,8 +71,17 @@ fn the_noon_sky_is_blue_and_the_sunset_horizon_warm() {
     let zenith = tables.sky_radiance(LocalRay::from_angles(r, 0.9, PI / 2.0, 0.0));
     assert!(zenith.z > zenith.y && zenith.y > zenith.x, "{zenith}");
     let sunset = tables.sky_radiance(LocalRay::from_angles(r, 0.02, 0.03, 0.0));
-    assert!(sunset.x > sunset.z, "toward a setting sun the horizon glows: {sunset}");
-    assert!(tables.multiple_scattering.texels.iter().all(|t| t.min_element() >= 0.0));
+    assert!(
+        sunset.x > sunset.z,
+        "toward a setting sun the horizon glows: {sunset}"
+    );
+    assert!(
+        tables
+            .multiple_scattering
+            .texels
+            .iter()
+            .all(|t| t.min_element() >= 0.0)
+    );
 }
 
 #[test]
@@ -98,7 +116,11 @@ fn free_flight(air: &Air, (p, dir): (Vec3, Vec3), c: usize, rng: &mut Rng) -> Re
     loop {
         t -= (1.0f32 - rng.next_f32()).ln() / majorant;
         if t >= exit {
-            return Err(if air.hits_ground(r, mu) { exit } else { f32::INFINITY });
+            return Err(if air.hits_ground(r, mu) {
+                exit
+            } else {
+                f32::INFINITY
+            });
         }
         let sample = air.at((p + dir * t).length());
         if rng.next_f32() < sample.extinction[c] / majorant {
@@ -116,7 +138,10 @@ fn sun_transmittance(air: &Air, p: Vec3, sun: Vec3, c: usize) -> f32 {
     let d = air.distance_to_top(r, mu);
     let n = 200;
     let depth: f32 = (0..n)
-        .map(|i| air.at((p + sun * (d * (i as f32 + 0.5) / n as f32)).length()).extinction[c])
+        .map(|i| {
+            air.at((p + sun * (d * (i as f32 + 0.5) / n as f32)).length())
+                .extinction[c]
+        })
         .sum::<f32>()
         * d
         / n as f32;
@@ -200,7 +225,13 @@ fn sky_error_against_a_path_tracer(visibility_m: f32) -> (f32, f32) {
     let tables = SkyTables::new(&air);
     let r = air.bottom_radius_m + 100.0;
     let mu_s = 20f32.to_radians().sin();
-    let views = [(89.0, 0.0), (30.0, 0.0), (30.0, 180.0), (10.0, 90.0), (4.0, 150.0)];
+    let views = [
+        (89.0, 0.0),
+        (30.0, 0.0),
+        (30.0, 180.0),
+        (10.0, 90.0),
+        (4.0, 150.0),
+    ];
     let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
     let (mut channel, mut lum) = (0.0f32, 0.0f32);
     let mut rng = Rng::new(7, 1);

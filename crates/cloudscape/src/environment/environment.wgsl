@@ -37,8 +37,8 @@ struct Environment {
 @group(2) @binding(2) var environment_multiple_scattering: texture_2d<f32>;
 @group(2) @binding(3) var environment_irradiance: texture_2d_array<f32>;
 @group(2) @binding(4) var environment_sky_view: texture_2d<f32>;
-@group(2) @binding(5) var environment_aerial_inscatter: texture_3d<f32>;
-@group(2) @binding(6) var environment_aerial_transmittance: texture_3d<f32>;
+@group(2) @binding(5) var environment_aerial_inscatter: texture_2d<f32>;     // atlas of slices
+@group(2) @binding(6) var environment_aerial_transmittance: texture_2d<f32>; // atlas of slices
 @group(2) @binding(7) var environment_cloud_shadow: texture_2d_array<f32>;
 @group(2) @binding(8) var environment_linear: sampler;
 
@@ -159,14 +159,25 @@ fn environment_aerial_perspective(radiance: vec3<f32>, coverage: f32, uv: vec2<f
         return radiance * clear + environment.sky_horizon_radiance * coverage * (1.0 - clear);
     }
     let slices = distance_m / ATMOSPHERE_AERIAL_SLICE_M;
-    let w = (slices - 0.5) / f32(ATMOSPHERE_AERIAL_SLICES);
-    let uvw = vec3<f32>(uv, clamp(w, 0.0, 1.0));
-    var inscatter = textureSampleLevel(environment_aerial_inscatter, environment_linear, uvw, 0.0).rgb;
-    var transmittance = textureSampleLevel(environment_aerial_transmittance, environment_linear, uvw, 0.0).rgb;
+    let w = clamp(slices - 1.0, 0.0, f32(ATMOSPHERE_AERIAL_SLICES - 1u));
+    let k0 = floor(w);
+    let k1 = min(k0 + 1.0, f32(ATMOSPHERE_AERIAL_SLICES - 1u));
+    let a = environment_aerial_texel_uv(uv, k0);
+    let b = environment_aerial_texel_uv(uv, k1);
+    var inscatter = mix(textureSampleLevel(environment_aerial_inscatter, environment_linear, a, 0.0).rgb, textureSampleLevel(environment_aerial_inscatter, environment_linear, b, 0.0).rgb, w - k0);
+    var transmittance = mix(textureSampleLevel(environment_aerial_transmittance, environment_linear, a, 0.0).rgb, textureSampleLevel(environment_aerial_transmittance, environment_linear, b, 0.0).rgb, w - k0);
     let near = clamp(slices, 0.0, 1.0);
     inscatter *= near;
     transmittance = mix(vec3<f32>(1.0), transmittance, near);
     return radiance * transmittance + environment.sun_irradiance * inscatter * coverage;
+}
+
+// Texture coordinates in the aerial-perspective atlas of screen position uv in slice k: the slice's
+// 32 x 32 texels, clamped to their centres so no neighbouring slice bleeds in.
+fn environment_aerial_texel_uv(uv: vec2<f32>, k: f32) -> vec2<f32> {
+    let size = vec2<f32>(ATMOSPHERE_AERIAL_SIZE);
+    let texel = clamp(uv * size, vec2<f32>(0.5), size - 0.5);
+    return vec2<f32>((k * size.x + texel.x) / (size.x * f32(ATMOSPHERE_AERIAL_SLICES)), texel.y / size.y);
 }
 
 // Texel coordinate in [-1, 1] of ground-plane offset x (in half extents, -1..1) in the warped

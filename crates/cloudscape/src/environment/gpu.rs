@@ -4,7 +4,8 @@
 use super::{Environment, SkyModel};
 use crate::atmosphere::Air;
 use crate::atmosphere::luts::{
-    AERIAL_SLICES, IRRADIANCE_SIZE, MULTIPLE_SCATTERING_SIZE, SKY_VIEW_SIZE, TRANSMITTANCE_SIZE,
+    AERIAL_SIZE, AERIAL_SLICES, IRRADIANCE_SIZE, MULTIPLE_SCATTERING_SIZE, SKY_VIEW_SIZE,
+    TRANSMITTANCE_SIZE,
 };
 use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{UNIFORM, bind_group, bind_group_layout, float_texture, uniform_buffer};
@@ -12,8 +13,6 @@ use crate::shadow::ShadowParams;
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
-/// Columns and rows of the aerial-perspective volume across the view (Hillaire 2020: 32 x 32).
-pub const AERIAL_SIZE: (u32, u32) = (32, 32);
 /// Format of every table: filterable everywhere, and storage-writable.
 pub const TABLE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
@@ -167,7 +166,7 @@ impl EnvironmentTable {
     }
 }
 
-/// One table texture: its size, layers (or depth) and dimension.
+/// One table texture: its size, layers and view dimension.
 struct TableShape {
     label: &'static str,
     size: (u32, u32, u32),
@@ -176,7 +175,9 @@ struct TableShape {
 
 /// The shapes of bindings 1-7 for a shadow map of `shadow_texels` per side.
 fn shapes(shadow_texels: u32) -> [TableShape; 7] {
-    use wgpu::TextureViewDimension::{D2, D2Array, D3};
+    use wgpu::TextureViewDimension::{D2, D2Array};
+    // The aerial perspective's slices side by side (`atmosphere_aerial.wgsl`).
+    let atlas = (AERIAL_SIZE.0 * AERIAL_SLICES, AERIAL_SIZE.1);
     let shape = |label, (w, h): (u32, u32), layers, dimension| TableShape {
         label,
         size: (w, h, layers),
@@ -187,29 +188,33 @@ fn shapes(shadow_texels: u32) -> [TableShape; 7] {
         shape("multiple scattering table", MULTIPLE_SCATTERING_SIZE, 1, D2),
         shape("sky irradiance table", IRRADIANCE_SIZE, 2, D2Array),
         shape("sky view table", SKY_VIEW_SIZE, 1, D2),
-        shape("aerial inscattering", AERIAL_SIZE, AERIAL_SLICES, D3),
-        shape("aerial transmittance", AERIAL_SIZE, AERIAL_SLICES, D3),
-        shape("cloud shadow map", (shadow_texels, shadow_texels), 2, D2Array),
+        shape("aerial inscattering", atlas, 1, D2),
+        shape("aerial transmittance", atlas, 1, D2),
+        shape(
+            "cloud shadow map",
+            (shadow_texels, shadow_texels),
+            2,
+            D2Array,
+        ),
     ]
 }
 
 fn make_texture(ctx: &GpuContext, shape: &TableShape, stand_in: bool) -> wgpu::Texture {
-    let (w, h, d) = if stand_in { (1, 1, shape.size.2.min(2)) } else { shape.size };
-    let dimension = match shape.dimension {
-        wgpu::TextureViewDimension::D3 => wgpu::TextureDimension::D3,
-        _ => wgpu::TextureDimension::D2,
+    let (w, h, layers) = if stand_in {
+        (1, 1, shape.size.2)
+    } else {
+        shape.size
     };
-    let depth = if stand_in && dimension == wgpu::TextureDimension::D3 { 1 } else { d };
     ctx.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(shape.label),
         size: wgpu::Extent3d {
             width: w,
             height: h,
-            depth_or_array_layers: depth,
+            depth_or_array_layers: layers,
         },
         mip_level_count: 1,
         sample_count: 1,
-        dimension,
+        dimension: wgpu::TextureDimension::D2,
         format: TABLE_FORMAT,
         usage: wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::STORAGE_BINDING
@@ -249,7 +254,9 @@ impl EnvironmentGpu {
         let buffer = uniform_buffer(ctx, "environment", size_of::<EnvironmentUniform>() as u64);
         let mut types = vec![UNIFORM];
         types.extend(shapes(1).iter().map(|s| float_texture(s.dimension)));
-        types.push(wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering));
+        types.push(wgpu::BindingType::Sampler(
+            wgpu::SamplerBindingType::Filtering,
+        ));
         let layout = bind_group_layout(&ctx.device, "environment", &types);
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("environment tables"),
@@ -379,16 +386,6 @@ impl EnvironmentGpu {
     /// The bind group for the pass that writes `table`: a stand-in in its place.
     pub fn bind_group_writing(&self, table: EnvironmentTable) -> &wgpu::BindGroup {
         &self.writing[Self::index(table)]
-    }
-
-    /// The texture (the first, for the aerial perspective's pair) of `table`.
-    pub fn texture(&self, table: EnvironmentTable) -> &wgpu::Texture {
-        &self.textures[table.bindings()[0] - 1]
-    }
-
-    /// The aerial perspective's transmittance volume.
-    pub fn aerial_transmittance(&self) -> &wgpu::Texture {
-        &self.textures[5]
     }
 
     /// Texels per side of the shadow map.

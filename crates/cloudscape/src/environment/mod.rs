@@ -26,16 +26,16 @@ mod passes;
 mod table_pass;
 
 pub use gpu::{
-    AERIAL_SIZE, AirUniform, CloudShadowUniform, EnvironmentGpu, EnvironmentTable,
-    EnvironmentUniform, TABLE_FORMAT,
+    AirUniform, CloudShadowUniform, EnvironmentGpu, EnvironmentTable, EnvironmentUniform,
+    TABLE_FORMAT,
 };
 pub use passes::EnvironmentPasses;
 pub use table_pass::TablePass;
 
 use crate::atmosphere::{Air, Atmosphere, SkyView};
 use crate::frame::direction_from_angles_deg;
-pub use crate::scene::SkyModel;
 use crate::scene::Scene;
+pub use crate::scene::SkyModel;
 use glam::Vec3;
 use std::f32::consts::{PI, TAU};
 use std::sync::Arc;
@@ -169,7 +169,6 @@ impl Environment {
             air: Air::from_scene(scene),
         }
     }
-
 }
 
 /// The environment seen from one viewpoint: the CPU twin of every function of `environment.wgsl`

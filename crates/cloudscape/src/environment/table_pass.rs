@@ -80,6 +80,13 @@ impl TablePass {
         let writing = environment.bind_group_writing(self.table);
         let groups = shared.bind_groups_with(self.slots, writing, group);
         let writes = timer.and_then(|t| t.compute_pass_writes(self.label));
-        crate::gpu::pipeline::dispatch_2d(encoder, self.label, &self.pipeline, &groups, size, writes);
+        crate::gpu::pipeline::dispatch_2d(
+            encoder,
+            self.label,
+            &self.pipeline,
+            &groups,
+            size,
+            writes,
+        );
     }
 }

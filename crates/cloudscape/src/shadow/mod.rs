@@ -155,7 +155,11 @@ impl ShadowParams {
         let span = self.top_y_m - self.bottom_y_m;
         let f = ((y - self.bottom_y_m) / span).clamp(0.0, 1.0) * CHECKPOINTS as f32;
         let i = (f as usize).min(CHECKPOINTS - 1);
-        let next = if i + 1 < CHECKPOINTS { column[i + 1] } else { 0.0 };
+        let next = if i + 1 < CHECKPOINTS {
+            column[i + 1]
+        } else {
+            0.0
+        };
         column[i] + (next - column[i]) * (f - i as f32)
     }
 }

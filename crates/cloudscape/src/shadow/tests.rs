@@ -23,7 +23,12 @@ fn the_warp_round_trips_and_is_finest_under_the_eye() {
         let a = params.ground_point((i, 0), 256).x;
         params.ground_point((i + 1, 0), 256).x - a
     };
-    assert!(texel(128) < 0.5 * texel(250), "{} {}", texel(128), texel(250));
+    assert!(
+        texel(128) < 0.5 * texel(250),
+        "{} {}",
+        texel(128),
+        texel(250)
+    );
     let edge = params.ground_point((255, 255), 256);
     assert!(edge.x < params.half_extent_m && edge.x > 0.95 * params.half_extent_m);
 }
@@ -60,7 +65,10 @@ fn the_map_reads_the_columns_and_a_clear_sky_casts_nothing() {
     let column = map.columns[0][ij.1 as usize * 32 + ij.0 as usize];
     let on_ground = map.optical_depth(Vec3::new(g.x, 0.0, g.y), 0);
     assert!((on_ground - column[0]).abs() <= 1e-3 * column[0].max(1.0));
-    assert_eq!(map.optical_depth(Vec3::new(g.x, params.top_y_m + 1.0, g.y), 0), 0.0);
+    assert_eq!(
+        map.optical_depth(Vec3::new(g.x, params.top_y_m + 1.0, g.y), 0),
+        0.0
+    );
 
     let mut clear = scene.clone();
     clear.layers.clear();
