@@ -47,11 +47,11 @@ for y, row in enumerate(images):
 grid.save(sys.argv[2])
 PY
 rm -rf "$trio"
-# A day from dawn to dusk (scenes/time-of-day.toml at solar times 6.5, 10.2, 13.8 and 17.5 h: its
-# path runs one solar hour per scene second from 6 h), and the four scenes built from METAR
+# A day from dawn to dusk (scenes/time-of-day.toml at solar times 4.5, 9.5, 14.5 and 19.5 h: its
+# path runs one solar hour per scene second from 4.3 h), and the four scenes built from METAR
 # reports, each a row of four.
 row=$(mktemp -d)
-"$cloudscape" animate scenes/time-of-day.toml --frames 4 --start-s 0.5 --fps 0.272727 \
+"$cloudscape" animate scenes/time-of-day.toml --frames 4 --start-s 0.2 --fps 0.2 \
     --width 480 --height 270 --out "$row/day"
 for i in 0 1 2 3; do mv "$row/day/frame_000$i.png" "$row/day-$i.png"; done
 for scene in metar-egll metar-low-stratus metar-fair-weather metar-thunderstorm; do

@@ -218,9 +218,27 @@ pub fn imports(source: &str) -> Vec<&str> {
 pub fn program(root: &str) -> String {
     let mut order = Vec::new();
     visit(root, &mut HashSet::new(), &mut order);
+    program_of(order.iter().map(|m| m.source))
+}
+
+/// A host's own WGSL `source` with the modules its `#import` lines name (and theirs) put before it:
+/// how a game engine's shader reaches the environment's functions, e.g. `#import environment` and
+/// `environment_cloud_sun_transmittance(p)` for the clouds' shadow on its geometry. The host binds
+/// [`crate::renderer::CloudRenderer::shared`]'s environment group at [`ENVIRONMENT_GROUP`] and
+/// keeps its own resources at other slots.
+pub fn host_program(source: &str) -> String {
+    let (mut seen, mut order) = (HashSet::new(), Vec::new());
+    for name in imports(source) {
+        visit(name, &mut seen, &mut order);
+    }
+    program_of(order.iter().map(|m| m.source).chain([source]))
+}
+
+/// The generated constants, then every source in order without its `#import` lines.
+fn program_of<'a>(sources: impl Iterator<Item = &'a str>) -> String {
     let mut text = constants_wgsl();
-    for m in order {
-        for line in m.source.lines() {
+    for source in sources {
+        for line in source.lines() {
             if !line.trim_start().starts_with("#import ") {
                 text.push_str(line);
                 text.push('\n');
@@ -252,6 +270,17 @@ fn visit(name: &str, seen: &mut HashSet<String>, order: &mut Vec<WgslModule>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_host_shader_reaches_the_cloud_shadow() {
+        let host = "#import environment\n\
+            @fragment fn host_fs(@location(0) p: vec3<f32>) -> @location(0) vec4<f32> {\n\
+                return vec4<f32>(vec3<f32>(environment_cloud_sun_transmittance(p)), 1.0);\n\
+            }\n";
+        let text = host_program(host);
+        assert!(text.contains("fn environment_cloud_sun_transmittance"));
+        crate::optics::test_support::validate_wgsl("host", &text);
+    }
 
     #[test]
     fn a_module_follows_everything_it_imports() {

@@ -92,7 +92,8 @@ struct MarchLight {
     from_below: vec3<f32>,
 }
 
-// MarchLight at p. Looked up once per ray, where it enters the clouds: the environment varies
+// MarchLight at p. Looked up once per ray, where it enters the cloud shell (not where empty-space
+// skipping finds the first cloud, so skipping cannot change the image): the environment varies
 // slowly over a cloud, and per-sample look-ups cost the march more than they change it.
 fn march_light(p: vec3<f32>) -> MarchLight {
     var below = environment_ground_radiance(frame.ground_albedo, p);
@@ -165,7 +166,7 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
     var distance_weighted = 0.0;
     var samples = 0u;
     let empty_until = march_empty_until(o, d, t0, t1, volume);
-    let light = march_light(o + d * max(t0, empty_until));
+    let light = march_light(o + d * t0);
     let first = march_first_stratum(t0, t1, n, empty_until);
     var t_start = march_stratum_t(t0, t1, f32(first) / f32(n));
     for (var i = first; i < n; i++) {
