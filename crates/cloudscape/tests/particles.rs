@@ -61,6 +61,7 @@ impl Harness {
             output: &self.output,
         };
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.clouds.encode_environment(ctx, &mut encoder, None);
         let region = (UVec2::ZERO, self.output.size);
         let shared = self.clouds.shared();
         self.particles
