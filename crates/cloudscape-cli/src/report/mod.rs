@@ -448,9 +448,10 @@ fn markdown(rows: &[Row], args: &ReportArgs, adapter: &str) -> String {
          Regenerate with `cargo run --release -p cloudscape-cli -- report` from the repository \
          root (path-traced references are cached in `target/realism-cache`; delete it after \
          changing the path tracer). Both renderers see the same cloud field, camera, sun disc, \
-         sky, ground and haze; the path tracer blends what the eye sees toward the horizon \
-         radiance by the distance of the first scattering or ground hit, the ray marcher by the \
-         transmittance-weighted mean cloud depth. The path tracer's noise is dominated by the \
+         ground and atmosphere (the same tables: the sun through the air at every altitude, the \
+         sky, the aerial perspective); the path tracer applies the air between the eye and the \
+         first scattering or ground hit, the ray marcher the air up to the transmittance-weighted \
+         mean cloud depth, and only the ray marcher's air is shadowed by the clouds. The path tracer's noise is dominated by the \
          forward peak of cloud droplets (approximate Mie, g = 0.995 for half the light): rare \
          paths that leave a cloud within a fraction of a degree of the sun carry most of the \
          aureole, which shows as fireflies and as a large relative-MSE noise floor. Where the sun \
