@@ -6,26 +6,11 @@ use std::path::Path;
 use cloudscape::animation::{scene_at, time_range_s};
 use cloudscape::gpu::GpuContext;
 use cloudscape::renderer::SceneRenderer;
-use cloudscape::scene::{Scene, SceneDocument, SceneError};
+use cloudscape::scene::{Scene, SceneDocument};
 use glam::Vec3;
+use scene_support::{assert_rejected, parse};
 
-fn parse(text: &str) -> Result<SceneDocument, SceneError> {
-    SceneDocument::parse(text, "scene.toml", Path::new("."), &[])
-}
-
-/// Parses `text`, which must fail at `line`:`column` about `key`, with `words` in the message.
-fn assert_rejected(text: &str, (line, column): (usize, usize), key: &str, words: &[&str]) {
-    let error = parse(text).expect_err("the scene should be rejected");
-    assert_eq!(
-        (error.line, error.column),
-        (Some(line), Some(column)),
-        "{error}"
-    );
-    assert_eq!(error.key.as_deref(), Some(key), "{error}");
-    for word in words {
-        assert!(error.message.contains(word), "{word:?} missing: {error}");
-    }
-}
+mod scene_support;
 
 const TWO_CAMERA_KEYS: &str = "\
 [[animation.camera_path]]

@@ -6,12 +6,11 @@ use std::path::Path;
 use cloudscape::field::CloudField;
 use cloudscape::field::profile::TYPE_GRADIENTS;
 use cloudscape::scene::metar::{CloudGenus, Cover};
-use cloudscape::scene::{CloudLayer, Scene, SceneDocument, SceneError};
+use cloudscape::scene::{CloudLayer, Scene, SceneDocument};
 use glam::Vec3;
+use scene_support::{assert_rejected, parse};
 
-fn parse(text: &str) -> Result<SceneDocument, SceneError> {
-    SceneDocument::parse(text, "scene.toml", Path::new("."), &[])
-}
+mod scene_support;
 
 /// The scene of a file that gives only `weather.metar = report`.
 fn metar_scene(report: &str) -> Scene {
@@ -223,20 +222,6 @@ fn an_obscured_sky_is_fog_up_to_the_vertical_visibility() {
         "5 % contrast at the VV"
     );
     assert!((scene.sky.visibility_m - 150.0 * 1.3059).abs() < 0.5);
-}
-
-/// Parses `text`, which must fail at `line`:`column` about `key`, with `words` in the message.
-fn assert_rejected(text: &str, (line, column): (usize, usize), key: &str, words: &[&str]) {
-    let error = parse(text).expect_err("the scene should be rejected");
-    assert_eq!(
-        (error.line, error.column),
-        (Some(line), Some(column)),
-        "{error}"
-    );
-    assert_eq!(error.key.as_deref(), Some(key), "{error}");
-    for word in words {
-        assert!(error.message.contains(word), "{word:?} missing: {error}");
-    }
 }
 
 #[test]

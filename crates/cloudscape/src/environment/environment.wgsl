@@ -12,8 +12,8 @@ struct CloudShadow {
     top_y_m: f32,              // world y above which no cloud lies
     sun_y: f32,                // sun direction's y, at least SHADOW_MIN_SUN_Y
     enabled: u32,              // 0: no clouds, the map reads zero
-    cloud_mean_cosine: f32,    // mean cosine g of the cloud droplets' phase function
     steps_per_checkpoint: u32, // samples of the coarse field between two checkpoints
+    pad0: u32,
     pad: vec2<u32>,
 }
 
@@ -237,13 +237,4 @@ fn environment_cloud_sky_optical_depth(p: vec3<f32>) -> f32 {
 // exp(-tau) (Beer-Lambert) from the shared map: the shadow a host's geometry receives.
 fn environment_cloud_sun_transmittance(p: vec3<f32>) -> f32 {
     return exp(-environment_cloud_sun_optical_depth(p));
-}
-
-// The share of the sun's light that reaches world point p through the clouds, direct beam and the
-// light they scatter forward (most of it within a few degrees of the sun): the Eddington diffuse
-// transmittance 1 / (1 + 3/4 (1 - g) tau) of the map's optical depth toward the sun (as
-// frame_diffuse_transmittance; optics::diffuse_transmittance). What the ground and the air see.
-fn environment_cloud_sun_visibility(p: vec3<f32>) -> f32 {
-    let tau = environment_cloud_sun_optical_depth(p);
-    return 1.0 / (1.0 + 0.75 * (1.0 - environment.shadow.cloud_mean_cosine) * tau);
 }

@@ -61,8 +61,8 @@ pub struct CloudShadowUniform {
     top_y_m: f32,
     sun_y: f32,
     enabled: u32,
-    cloud_mean_cosine: f32,
     steps_per_checkpoint: u32,
+    pad0: u32,
     pad: [u32; 2],
 }
 
@@ -77,8 +77,8 @@ impl CloudShadowUniform {
             top_y_m: params.top_y_m,
             sun_y: params.sun_y,
             enabled: u32::from(params.enabled),
-            cloud_mean_cosine: params.cloud_mean_cosine,
             steps_per_checkpoint: params.steps_per_checkpoint,
+            pad0: 0,
             pad: [0; 2],
         }
     }
@@ -446,8 +446,8 @@ mod tests {
                 top_y_m,
                 sun_y,
                 enabled,
-                cloud_mean_cosine,
                 steps_per_checkpoint,
+                pad0,
                 pad,
             }
         );

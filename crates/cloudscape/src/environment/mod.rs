@@ -13,7 +13,7 @@
 //! - `environment_aerial_perspective(radiance, coverage, uv, distance_m)`: the haze, applied once,
 //!   in compositing;
 //! - `environment_cloud_sun_optical_depth(p)`, `environment_cloud_sky_optical_depth(p)`,
-//!   `environment_cloud_sun_visibility(p)`, `environment_cloud_sun_transmittance(p)`: the clouds'
+//!   `environment_cloud_sun_transmittance(p)`: the clouds'
 //!   shared shadow map ([`crate::shadow`]), for the ground, the air and a host's geometry.
 //!
 //! `sky.model = "atmosphere"` (the default) puts Hillaire 2020's atmosphere ([`crate::atmosphere`])

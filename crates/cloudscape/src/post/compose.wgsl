@@ -21,7 +21,7 @@ fn compose_ground(g: vec3<f32>) -> vec3<f32> {
     let sky_part = frame.ground_albedo / PI * environment_sky_irradiance_up(g);
     var sun_t = 0.0;
     if sun.y > 0.0 {
-        sun_t = environment_cloud_sun_visibility(g);
+        sun_t = frame_diffuse_transmittance(environment_cloud_sun_optical_depth(g));
     }
     let sky_t = frame_diffuse_transmittance(environment_cloud_sky_optical_depth(g));
     return sun_part * sun_t + sky_part * sky_t;

@@ -15,7 +15,6 @@
 pub mod gpu;
 
 use crate::field::CloudField;
-use crate::optics::phase::PhaseLobes;
 use crate::scene::{PlanetShape, Scene};
 use glam::{Vec2, Vec3};
 
@@ -42,8 +41,6 @@ pub struct ShadowParams {
     pub sun_y: f32,
     /// Whether there are clouds at all (the map reads zero when not).
     pub enabled: bool,
-    /// Mean cosine of the cloud droplets' phase function (for the diffuse transmittance).
-    pub cloud_mean_cosine: f32,
     /// Samples of the coarse field between two checkpoints.
     pub steps_per_checkpoint: u32,
 }
@@ -71,7 +68,6 @@ impl ShadowParams {
             top_y_m: top.max(bottom - drop + 1.0),
             sun_y,
             enabled,
-            cloud_mean_cosine: PhaseLobes::from_scene(&scene.phase).mean_cosine(),
             steps_per_checkpoint: scene.shadow.steps.div_ceil(CHECKPOINTS as u32).max(1),
         }
     }
