@@ -94,12 +94,14 @@ fn environment_sun_irradiance(p: vec3<f32>) -> vec3<f32> {
 // SunDisc::radiance.
 fn environment_sun_disc_radiance(d: vec3<f32>) -> vec3<f32> {
     let one_minus_cos_radius = 1.0 - environment.sun_cos_angular_radius;
-    let cos_angle = dot(d, environment.sun_direction);
-    if one_minus_cos_radius <= 0.0 || cos_angle < environment.sun_cos_angular_radius {
+    // 1 - cos(theta) = |d - s|^2 / 2, exact for the tiny angles where 1 - dot(d, s) is not.
+    let chord = d - environment.sun_direction;
+    let one_minus_cos_angle = 0.5 * dot(chord, chord);
+    if one_minus_cos_radius <= 0.0 || one_minus_cos_angle > one_minus_cos_radius {
         return vec3<f32>(0.0);
     }
     let u = environment.sun_limb_darkening;
-    let mu = sqrt(clamp(1.0 - (1.0 - cos_angle) / one_minus_cos_radius, 0.0, 1.0));
+    let mu = sqrt(clamp(1.0 - one_minus_cos_angle / one_minus_cos_radius, 0.0, 1.0));
     let limb = (1.0 - u * (1.0 - mu)) / (1.0 - u / 3.0);
     return environment_sun_irradiance(environment.viewpoint_m) * limb / (2.0 * PI * one_minus_cos_radius);
 }

@@ -121,12 +121,14 @@ impl SunDisc {
     /// The compositor draws this disc and the path tracer sees it.
     pub fn radiance_of(&self, irradiance: Vec3, dir: Vec3) -> Vec3 {
         let one_minus_cos_radius = 1.0 - self.cos_radius;
-        let cos_angle = dir.dot(self.direction);
-        if one_minus_cos_radius <= 0.0 || cos_angle < self.cos_radius {
+        // 1 - cos(theta) = |d - s|^2 / 2 for unit vectors: exact where theta is tiny, where
+        // 1 - dot(d, s) loses all but a few bits in f32 (the disc is 1e-5 across in cosine).
+        let one_minus_cos_angle = 0.5 * (dir - self.direction).length_squared();
+        if one_minus_cos_radius <= 0.0 || one_minus_cos_angle > one_minus_cos_radius {
             return Vec3::ZERO;
         }
         let u = self.limb_darkening;
-        let mu = (1.0 - (1.0 - cos_angle) / one_minus_cos_radius)
+        let mu = (1.0 - one_minus_cos_angle / one_minus_cos_radius)
             .clamp(0.0, 1.0)
             .sqrt();
         let limb = (1.0 - u * (1.0 - mu)) / (1.0 - u / 3.0);
