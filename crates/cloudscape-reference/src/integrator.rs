@@ -5,14 +5,20 @@
 //! then the sky and the sun disc are seen directly). At every scattering vertex:
 //!
 //! - the sun: one direction uniform over its disc, weighted by the phase function (or the
-//!   Lambertian BRDF on the ground) and by ratio-tracked transmittance, combined by the power
-//!   heuristic with continuations that leave the medium through the disc;
+//!   Lambertian BRDF on the ground) and by ratio-tracked transmittance;
+//! - the sun's forward peak, probed: one direction from a narrow lobe about the sun, followed to
+//!   its next collision, where the sun is estimated as above ([`PathTracer::peak_probe`]);
 //! - the sky (in the medium): one direction from [`Environment::sample_sky`], combined with the
 //!   phase-sampled continuation by the power heuristic (Veach 1997, "Robust Monte Carlo Methods
 //!   for Light Transport Simulation", section 9.2); on the ground the cosine-sampled continuation
 //!   alone gathers the sky (it already samples the BRDF times cosine exactly);
 //! - the continuation: the phase function sampled exactly (or the cosine-weighted hemisphere on
-//!   the ground), mixed with a narrow lobe about the sun that finds the forward-scattered aureole.
+//!   the ground), so the throughput only ever falls.
+//!
+//! Sunlight reaches a path in three ways that overlap, and each path that sees the sun is weighted
+//! against all three by the power heuristic ([`SunStrategies`]): the disc sampled from the vertex
+//! before the sun, the continuation from that vertex leaving through the disc, and the probe from
+//! the vertex before it.
 //!
 //! Throughput is multiplied by the single-scattering albedo at each collision and by the ground
 //! albedo at each bounce; Russian roulette on a low throughput ends paths without bias. Paths have
@@ -108,14 +114,15 @@ impl<M: Medium> PathTracer<M> {
     fn path_radiance(&self, mut vertex: Vertex, rng: &mut Rng) -> Vec3 {
         let mut throughput = Vec3::ONE;
         let mut radiance = Vec3::ZERO;
-        for events in 0..self.max_scattering_orders.min(MAX_SCATTERING_EVENTS) {
+        let mut arrival = Arrival::FROM_CAMERA;
+        for _ in 0..self.max_scattering_orders.min(MAX_SCATTERING_EVENTS) {
             if matches!(vertex, Vertex::Medium { .. }) {
                 throughput *= self.albedo;
             }
-            let guided = events < SUN_GUIDED_EVENTS;
-            radiance += throughput
-                * (self.sun_light(vertex, guided, rng) + self.sky_light(vertex, guided, rng));
-            let next = self.continue_from(vertex, guided, rng);
+            let sun = self.sun_light(vertex, arrival, Strategy::Disc, rng);
+            let probe = self.peak_probe(vertex, rng);
+            radiance += throughput * (sun + probe + self.sky_light(vertex, rng));
+            let next = self.continue_from(vertex, rng);
             throughput *= next.weight;
             if !roulette(&mut throughput, rng) {
                 break;
@@ -133,9 +140,13 @@ impl<M: Medium> PathTracer<M> {
                 None => {
                     let weight = power_heuristic(next.pdf, next.sky_pdf);
                     radiance += throughput * self.environment.sky_radiance(next.dir) * weight;
-                    radiance += throughput * self.sun_reached(origin, next.dir, next.pdf);
+                    radiance += throughput * self.sun_reached(origin, next.dir, next.pdf, arrival);
                     break;
                 }
+            };
+            arrival = Arrival {
+                continuation_pdf: next.pdf,
+                probe_pdf: self.probe_pdf(next.dir),
             };
         }
         radiance
@@ -149,51 +160,103 @@ impl<M: Medium> PathTracer<M> {
         self.volume.transmittance(origin, dir, f32::INFINITY, rng)
     }
 
-    /// Next-event estimate of the sun's light scattered at `vertex` toward the path, weighted
-    /// against the continuation's chance of reaching the disc by the power heuristic (the
-    /// continuation's share is [`Self::sun_reached`]). Without the weighting, a phase function
-    /// whose forward peak is narrower than the disc (cloud droplets' is about 0.3 degrees) turns
-    /// the rare vertices whose path points at the sun into fireflies.
-    fn sun_light(&self, vertex: Vertex, guided: bool, rng: &mut Rng) -> Vec3 {
+    /// Next-event estimate of the sun's light scattered at `vertex` (reached by `arrival`) toward
+    /// the path: one direction uniform over the disc, weighted as `strategy` among the ways
+    /// sunlight reaches the path ([`SunStrategies`]).
+    fn sun_light(
+        &self,
+        vertex: Vertex,
+        arrival: Arrival,
+        strategy: Strategy,
+        rng: &mut Rng,
+    ) -> Vec3 {
         let Some(sun) = self.environment.sun else {
             return Vec3::ZERO;
         };
         let dir = crate::sampling::uniform_cone(sun.direction, sun.cos_radius, rng.next_vec2());
-        let (scattering, continuation_pdf) = self.scattering(vertex, guided, dir);
+        let (scattering, leave_pdf) = self.scattering(vertex, dir);
         if scattering.max_element() <= 0.0 {
             return Vec3::ZERO;
         }
         // Uniform over the disc: radiance E / Omega over density 1 / Omega leaves E.
-        let weight = match sun_disc_pdf(&sun) {
-            Some(pdf) => power_heuristic(pdf, continuation_pdf),
-            None => 1.0,
-        };
+        let weight = SunStrategies::new(&sun, arrival, leave_pdf).weight(strategy);
+        if weight <= 0.0 {
+            return Vec3::ZERO;
+        }
         let p = position(vertex);
         self.environment.sun_irradiance(p) * scattering * (weight * self.visibility(p, dir, rng))
     }
 
-    /// The sun disc's radiance seen by a continuation that left the medium from `origin` along
-    /// `dir` (drawn with density `pdf`), weighted against the sun's next-event estimate.
-    fn sun_reached(&self, origin: Vec3, dir: Vec3, pdf: f32) -> Vec3 {
+    /// The sun disc's radiance seen by a continuation that left the medium from `origin` (reached
+    /// by `arrival`) along `dir`, drawn with density `pdf`, weighted against the other ways
+    /// sunlight reaches the path.
+    fn sun_reached(&self, origin: Vec3, dir: Vec3, pdf: f32, arrival: Arrival) -> Vec3 {
         let Some(sun) = self.environment.sun else {
             return Vec3::ZERO;
         };
-        match sun_disc_pdf(&sun) {
-            Some(light_pdf) if dir.dot(sun.direction) >= sun.cos_radius => {
-                self.environment.sun_disc_radiance(origin, dir) * power_heuristic(pdf, light_pdf)
-            }
-            _ => Vec3::ZERO,
+        let radiance = self.environment.sun_disc_radiance(origin, dir);
+        if radiance.max_element() <= 0.0 {
+            return Vec3::ZERO;
         }
+        radiance * SunStrategies::new(&sun, arrival, pdf).weight(Strategy::Leaving)
+    }
+
+    /// Probes the forward peak of the sun: the light that reaches `vertex` after one more
+    /// scattering within a few tenths of a degree of the sun's direction.
+    ///
+    /// Half of a cloud droplet's scattering stays within about 0.3 degrees (its diffraction
+    /// peak), so at a collision whose path happens to point at the sun the disc's next-event
+    /// estimate is thousands of times the usual one: a firefly, and the aureole of every deep
+    /// vertex is made of them. The probe draws that direction on purpose, from a
+    /// Henyey-Greenstein lobe about the sun ([`SUN_PROBE_G`]), follows it by delta tracking to its
+    /// next collision and estimates the sun there; the regular estimate at such a collision gives
+    /// way to it by the power heuristic, since the lobe draws those directions far more often than
+    /// the phase function does. It is a dead end (the path goes on from `vertex` by its own
+    /// continuation), so unlike a continuation mixed with the lobe it never multiplies the
+    /// throughput by more than one. One-sample MIS over sampling techniques: Veach 1997,
+    /// section 9.2.
+    fn peak_probe(&self, vertex: Vertex, rng: &mut Rng) -> Vec3 {
+        let Some(sun) = self.environment.sun else {
+            return Vec3::ZERO;
+        };
+        let lobe = PhaseLobes::henyey_greenstein(SUN_PROBE_G);
+        let dir = lobe.sample(sun.direction, rng.next_vec3());
+        let (value, continuation_pdf) = self.scattering(vertex, dir);
+        let probe_pdf = self.probe_pdf(dir);
+        if value.max_element() <= 0.0 || probe_pdf <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let origin = position(vertex);
+        let ground_m = self.environment.ground_distance(origin, dir);
+        let Some(t) = self.volume.free_flight(origin, dir, ground_m, rng) else {
+            return Vec3::ZERO;
+        };
+        let collision = Vertex::Medium {
+            position: origin + dir * t,
+            dir,
+        };
+        let arrival = Arrival {
+            continuation_pdf,
+            probe_pdf,
+        };
+        value * (self.albedo / probe_pdf) * self.sun_light(collision, arrival, Strategy::Probe, rng)
+    }
+
+    /// Density with which [`Self::peak_probe`] draws `dir`; 0 without a sun.
+    fn probe_pdf(&self, dir: Vec3) -> f32 {
+        self.environment.sun.map_or(0.0, |sun| {
+            cloudscape::optics::henyey_greenstein(SUN_PROBE_G, sun.direction.dot(dir))
+        })
     }
 
     /// Next-event estimate of the sky's light scattered at a medium vertex, weighted against
     /// the continuation's sampling by the power heuristic.
-    fn sky_light(&self, vertex: Vertex, guided: bool, rng: &mut Rng) -> Vec3 {
+    fn sky_light(&self, vertex: Vertex, rng: &mut Rng) -> Vec3 {
         let Vertex::Medium { position, .. } = vertex else {
             return Vec3::ZERO;
         };
         let (sky_dir, sky_pdf) = self.environment.sample_sky(position, rng.next_vec2());
-        let (phase, continuation_pdf) = self.scattering(vertex, guided, sky_dir);
+        let (phase, continuation_pdf) = self.scattering(vertex, sky_dir);
         let weight = power_heuristic(sky_pdf, continuation_pdf);
         if weight <= 0.0 {
             return Vec3::ZERO;
@@ -207,18 +270,10 @@ impl<M: Medium> PathTracer<M> {
         self.environment.ground_albedo.unwrap_or(Vec3::ZERO) / PI
     }
 
-    /// The sun lobe that continuations are partly drawn from: its direction and shape; None
-    /// without a sun or where the vertex is not `guided`.
-    fn sun_guide(&self, guided: bool) -> Option<(Vec3, PhaseLobes)> {
-        let sun = self.environment.sun.filter(|_| guided)?;
-        Some((sun.direction, PhaseLobes::henyey_greenstein(SUN_GUIDE_G)))
-    }
-
     /// At `vertex`, for leaving toward `next`: the scattering factor (phase function, or BRDF
-    /// times cosine) and the density of the continuation sampling, the mixture of the vertex's
-    /// own sampling and the sun lobe.
-    fn scattering(&self, vertex: Vertex, guided: bool, next: Vec3) -> (Vec3, f32) {
-        let (value, own_pdf) = match vertex {
+    /// times cosine) and the density with which the continuation draws `next`.
+    fn scattering(&self, vertex: Vertex, next: Vec3) -> (Vec3, f32) {
+        match vertex {
             Vertex::Medium { dir, .. } => {
                 let p = self.phase.eval(dir.dot(next));
                 (Vec3::splat(p), p)
@@ -227,36 +282,18 @@ impl<M: Medium> PathTracer<M> {
                 let cos = g.normal.dot(next).max(0.0);
                 (self.ground_brdf() * cos, cos / PI)
             }
-        };
-        let pdf = match self.sun_guide(guided) {
-            Some((toward, lobe)) => {
-                SUN_GUIDE_PROBABILITY * lobe.eval(toward.dot(next))
-                    + (1.0 - SUN_GUIDE_PROBABILITY) * own_pdf
-            }
-            None => own_pdf,
-        };
-        (value, pdf)
+        }
     }
 
-    /// Samples the direction a path leaves `vertex` in: the phase function (or the cosine-weighted
-    /// hemisphere on the ground), or with probability [`SUN_GUIDE_PROBABILITY`] a narrow lobe
-    /// about the sun. The sun lobe finds the bright aureole that the forward peak of cloud
-    /// droplets makes around the sun in thin cloud, which the other sampling finds only rarely
-    /// and then as a firefly; the throughput weight `f / (mixture pdf)` keeps it unbiased
-    /// (one-sample multiple importance sampling, Veach 1997, section 9.2.4). Only the first
-    /// [`SUN_GUIDED_EVENTS`] vertices of a path are `guided`: the weight `f / pdf` of the
-    /// mixture is up to `1 / (1 - p)` away from the sun, and over the hundreds of bounces of a
-    /// cloud path such factors would multiply into fireflies.
-    fn continue_from(&self, vertex: Vertex, guided: bool, rng: &mut Rng) -> Continuation {
-        let guide = self.sun_guide(guided);
-        let dir = match (guide, vertex) {
-            (Some((toward, lobe)), _) if rng.next_f32() < SUN_GUIDE_PROBABILITY => {
-                lobe.sample(toward, rng.next_vec3())
-            }
-            (_, Vertex::Medium { dir, .. }) => self.phase.sample(dir, rng.next_vec3()),
-            (_, Vertex::Ground(g)) => crate::sampling::cosine_hemisphere(g.normal, rng.next_vec2()),
+    /// Samples the direction a path leaves `vertex` in: the phase function exactly, or the
+    /// cosine-weighted hemisphere on the ground; the throughput weight `f / pdf` is 1 (the albedo
+    /// on the ground).
+    fn continue_from(&self, vertex: Vertex, rng: &mut Rng) -> Continuation {
+        let dir = match vertex {
+            Vertex::Medium { dir, .. } => self.phase.sample(dir, rng.next_vec3()),
+            Vertex::Ground(g) => crate::sampling::cosine_hemisphere(g.normal, rng.next_vec2()),
         };
-        let (value, pdf) = self.scattering(vertex, guided, dir);
+        let (value, pdf) = self.scattering(vertex, dir);
         let sky_pdf = match vertex {
             Vertex::Medium { position, .. } => self.environment.sky_pdf(position, dir),
             Vertex::Ground(_) => 0.0,
@@ -270,14 +307,72 @@ impl<M: Medium> PathTracer<M> {
     }
 }
 
-/// Probability of drawing a continuation from the sun lobe instead of the vertex's own sampling.
-const SUN_GUIDE_PROBABILITY: f32 = 0.25;
-/// Vertices of a path (counted from the first) whose continuation is partly drawn from the sun lobe:
-/// the ground and the cloud surfaces first seen, where the aureole shows.
-const SUN_GUIDED_EVENTS: u32 = 2;
-/// Asymmetry of the Henyey-Greenstein sun lobe: half its peak within 0.36 degrees of the sun, the
-/// width of the sun disc blurred by the forward peak of 20 um droplets.
-const SUN_GUIDE_G: f32 = 0.992;
+/// How a path arrived at a vertex, as the vertex before saw it: the density its continuation drew
+/// the direction with, and the density [`PathTracer::peak_probe`] would have drawn it with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Arrival {
+    continuation_pdf: f32,
+    probe_pdf: f32,
+}
+
+impl Arrival {
+    /// The camera's ray: fixed, so no probe could have drawn it.
+    const FROM_CAMERA: Arrival = Arrival {
+        continuation_pdf: 1.0,
+        probe_pdf: 0.0,
+    };
+}
+
+/// The ways a path ending `vertex before -> vertex -> sun` is drawn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Strategy {
+    /// Arrival by the continuation, the sun's direction from the disc (next-event estimation).
+    Disc,
+    /// Arrival by the continuation, the sun's direction by the continuation leaving the medium.
+    Leaving,
+    /// Arrival by the probe, the sun's direction from the disc.
+    Probe,
+}
+
+/// The densities of one sunlit path under each [`Strategy`], for the power heuristic (Veach
+/// 1997, section 9.2): each strategy's density is the product of the densities of the path's last
+/// two directions under it.
+struct SunStrategies {
+    disc: f32,
+    leaving: f32,
+    probe: f32,
+}
+
+impl SunStrategies {
+    /// The path that arrived by `arrival` and leaves toward the sun in a direction the vertex's
+    /// continuation draws with density `leave_pdf`. A point sun has no disc to draw or leave
+    /// through: its next-event estimate is a delta (density 1 against 0 for leaving).
+    fn new(sun: &SunDisc, arrival: Arrival, leave_pdf: f32) -> SunStrategies {
+        let (disc_pdf, leave_pdf) = sun_disc_pdf(sun).map_or((1.0, 0.0), |d| (d, leave_pdf));
+        SunStrategies {
+            disc: arrival.continuation_pdf * disc_pdf,
+            leaving: arrival.continuation_pdf * leave_pdf,
+            probe: arrival.probe_pdf * disc_pdf,
+        }
+    }
+
+    /// The power-heuristic weight of `strategy`.
+    fn weight(&self, strategy: Strategy) -> f32 {
+        let own = match strategy {
+            Strategy::Disc => self.disc,
+            Strategy::Leaving => self.leaving,
+            Strategy::Probe => self.probe,
+        };
+        let sum = self.disc * self.disc + self.leaving * self.leaving + self.probe * self.probe;
+        if sum > 0.0 { own * own / sum } else { 0.0 }
+    }
+}
+
+/// Asymmetry of the Henyey-Greenstein lobe of the sun probe: half its peak within 0.36 degrees of
+/// the sun, the width of the sun disc blurred by the forward peak of 20 um droplets (whose HG lobe
+/// has g = 0.9946, Jendersie & d'Eon 2023), and wider than that peak, so the ratio of the peak to
+/// the lobe stays bounded.
+const SUN_PROBE_G: f32 = 0.992;
 
 /// Below this largest throughput component, paths play Russian roulette.
 const ROULETTE_THRESHOLD: f32 = 0.25;
