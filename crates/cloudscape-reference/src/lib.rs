@@ -43,3 +43,8 @@ pub use integrator::PathTracer;
 pub use particle_set_medium::ParticleSetMedium;
 pub use render::{PixelEstimate, ProgressiveRender, RenderStats};
 pub use scene::DEFAULT_MAJORANT_CELLS;
+
+/// The revision of what the path tracer converges to: raised by every change that moves its
+/// expected image (a fix, a new effect), and only by those, so that references stored with an
+/// older revision are traced anew while changes that only lower the noise keep them.
+pub const TRACER_REVISION: u32 = 1;

@@ -67,13 +67,21 @@ impl<'a, M: Medium> ProgressiveRender<'a, M> {
     /// An empty render of `tracer`'s frame; `seed` picks the random numbers (the same seed gives
     /// the same image, whatever the passes and the thread count).
     pub fn new(tracer: &'a PathTracer<M>, seed: u64) -> Self {
+        Self::starting_at(tracer, seed, 0)
+    }
+
+    /// An empty render whose samples continue `seed`'s sequence from sample `first_sample`: the
+    /// samples a render of `seed` that took `first_sample` per pixel did not take, so the two
+    /// renders' means, weighted by their sample counts, are one render of `seed` (how a stored
+    /// reference is extended).
+    pub fn starting_at(tracer: &'a PathTracer<M>, seed: u64, first_sample: u32) -> Self {
         let size = tracer.frame.size;
         ProgressiveRender {
             tracer,
             seed,
             width: size.x as usize,
             pixels: vec![PixelSums::default(); size.x as usize * size.y as usize],
-            next_sample: 0,
+            next_sample: first_sample,
             elapsed: Duration::ZERO,
         }
     }

@@ -213,6 +213,16 @@ fn seeds_agree_within_variance_and_repeat_exactly() {
     );
     assert_eq!(render(1, &[40, 56]).image(), a.image());
     assert_eq!(a.stats().non_finite, 0);
+    // A render continuing seed 1 from sample 40 holds exactly the samples the first 40 lack.
+    let mut rest = ProgressiveRender::starting_at(&t, 1, 40);
+    assert!(rest.run_pass(56, &|| false, &|_| {}));
+    let (first, rest) = (render(1, &[40]).image(), rest.image());
+    for ((p, q), whole) in first.pixels.iter().zip(&rest.pixels).zip(&a.image().pixels) {
+        for c in 0..3 {
+            let joined = (40.0 * p[c] + 56.0 * q[c]) / 96.0;
+            assert!((joined - whole[c]).abs() <= 1e-5 * whole[c].abs().max(1e-3));
+        }
+    }
 }
 
 /// The forward peak of cloud droplets converges: under a slab of optical depth 4 lit by the real

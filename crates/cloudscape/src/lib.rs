@@ -33,5 +33,6 @@ pub mod scene;
 pub mod shader;
 pub mod shadow;
 pub mod sprites;
+pub mod stable_hash;
 pub mod technique;
 pub mod temporal;

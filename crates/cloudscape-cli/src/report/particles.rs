@@ -6,19 +6,18 @@
 //!
 //! The total, the particles against the field's reference, is what a user sees.
 
-use super::{ReportArgs, cached_trace, render_with};
+use super::keys::particle_key;
+use super::measure::Measurement;
+use super::references::{Budget, Reference, ReferenceStore};
 use crate::compare::Comparison;
 use anyhow::Result;
-use cloudscape::gpu::GpuContext;
 use cloudscape::image::{HdrImage, write_image};
 use cloudscape::particles::ParticleTableSpec;
 use cloudscape::particles::density::RadialProfile;
 use cloudscape::particles::generate::{self, Generation};
-use cloudscape::scene::{SceneDocument, Technique};
 use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer};
 use glam::UVec2;
 use std::fmt::Write as _;
-use std::hash::{Hash, Hasher};
 use std::path::Path;
 
 /// The particle technique on one scene.
@@ -31,61 +30,69 @@ pub struct ParticleRow {
     pub shape: Comparison,
     /// Particles generated (the CPU specification's count).
     pub count: usize,
-    /// Wall time of the GPU render, ms.
-    pub gpu_ms: f64,
+    /// The path-traced particles' noise floor: their two halves against each other.
+    pub noise_floor: Comparison,
 }
 
-/// Renders the scene with particles, traces its particle set (cached under the field's `key`
-/// and the set itself) and compares both with the field's reference `field`; writes the images
-/// beside the ray marcher's. None where the scene makes no particles.
+/// Where the particle row finds its references: the store, the budget and the field's key.
+pub struct Sources<'a> {
+    /// The stored references.
+    pub store: &'a ReferenceStore,
+    /// How much tracing is allowed.
+    pub budget: Budget,
+    /// The key of the scene's field reference.
+    pub field_key: &'a str,
+}
+
+/// Compares the particle render `m` with the field's reference `field` and with the path-traced
+/// particle set (stored as `NAME-particles`); writes the images beside the ray marcher's. None
+/// where the scene makes no particles.
 pub fn row(
     name: &str,
-    doc: &SceneDocument,
-    ctx: &GpuContext,
-    (args, key): (&ReportArgs, &str),
+    m: &Measurement,
+    sources: &Sources,
     (field, images): (&HdrImage, &Path),
 ) -> Result<Option<ParticleRow>> {
-    let (renderer, scene, gpu, gpu_ms) = render_with(doc, ctx, Technique::Particles)?;
-    let spec = ParticleTableSpec::from_scene(&scene);
-    let generation =
-        Generation::from_scene(&scene, RadialProfile::of(&spec.particle).volume_mean());
-    let particles = generate::generate(renderer.field(), &generation);
+    let scene = &m.scene;
+    let spec = ParticleTableSpec::from_scene(scene);
+    let generation = Generation::from_scene(scene, RadialProfile::of(&spec.particle).volume_mean());
+    let particles = generate::generate(m.renderer.field(), &generation);
     if particles.is_empty() {
         return Ok(None);
     }
-    let mut hasher = std::collections::hash_map::DefaultHasher::new();
-    (key, spec.particle.seed, spec.particle.style.gpu_index()).hash(&mut hasher);
-    let mut sorted = particles.clone();
-    sorted.sort_by_key(|p| p.id);
-    for p in &sorted {
-        (p.id, p.centre_m.to_array().map(f32::to_bits)).hash(&mut hasher);
-        [p.radius_m, p.height_m, p.density]
-            .map(f32::to_bits)
-            .hash(&mut hasher);
-    }
-    let size = UVec2::new(scene.render.width, scene.render.height);
-    let reference = cached_trace(&format!("{:016x}", hasher.finish()), size, args, || {
-        Ok(PathTracer::for_particle_set(
-            &scene,
-            size,
-            &particles,
-            spec.particle,
-            spec.extinction_per_m,
-            DEFAULT_MAJORANT_CELLS,
-        ))
-    })?;
-    let traced = super::average(&reference.halves);
+    let key = particle_key(
+        sources.field_key,
+        spec.particle.seed,
+        spec.particle.style.gpu_index(),
+        &particles,
+    );
+    let size = (scene.render.width, scene.render.height);
+    let reference: Reference = sources.store.obtain(
+        &format!("{name}-particles"),
+        (&key, size),
+        sources.budget,
+        || {
+            Ok(PathTracer::for_particle_set(
+                scene,
+                UVec2::new(size.0, size.1),
+                &particles,
+                spec.particle,
+                spec.extinction_per_m,
+                DEFAULT_MAJORANT_CELLS,
+            ))
+        },
+    )?;
+    let traced = reference.image();
     let path = |kind: &str| images.join(format!("{name}-{kind}.png"));
-    let total = Comparison::of(field, &gpu.hdr, Some(&path("particles-flip")))?;
-    gpu.ldr.write_png(&path("particles"))?;
+    m.write_images(field, &path("particles"), &path("particles-flip"))?;
     let (ev, op) = (scene.render.exposure_ev, scene.render.tonemap);
     write_image(&path("particle-reference"), &traced, ev, op)?;
     let row = ParticleRow {
-        lighting: Comparison::of(&traced, &gpu.hdr, None)?,
+        total: m.comparison.clone(),
+        lighting: Comparison::of(&traced, &m.rendered.hdr, None)?,
         shape: Comparison::of(field, &traced, None)?,
-        total,
         count: particles.len(),
-        gpu_ms,
+        noise_floor: Comparison::of(&reference.halves[0], &reference.halves[1], None)?,
     };
     eprintln!(
         "particles: {} made; HDR-FLIP total {:.4}, lighting {:.4}, shape {:.4}",
@@ -108,10 +115,10 @@ pub fn markdown<'a>(
          (the particle set as a medium, the sum of the particles' densities): the error of the \
          precomputed tables, the light occlusion and the blending. *Shape* compares the \
          path-traced particles with the path-traced field: the error of turning the field into \
-         particles, whatever the lighting. The particle references are traced with the same \
-         samples and seeds as the field's. The particle technique does not turn voxel grids into \
-         particles: the voxel scene makes none.\n\n\
-         | scene | particles | total HDR-FLIP | total relMSE | lighting HDR-FLIP | lighting relMSE | shape HDR-FLIP | shape relMSE | GPU ms |\n\
+         particles, whatever the lighting. The particle references are stored and extended as the \
+         field's are; their noise floor is their two halves against each other. The particle \
+         technique does not turn voxel grids into particles: the voxel scene makes none.\n\n\
+         | scene | particles | total HDR-FLIP | total relMSE | lighting HDR-FLIP | lighting relMSE | shape HDR-FLIP | shape relMSE | noise floor HDR-FLIP |\n\
          |---|---|---|---|---|---|---|---|---|"
     );
     for (title, r) in rows {
@@ -121,7 +128,7 @@ pub fn markdown<'a>(
         };
         let _ = writeln!(
             s,
-            "| {title} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.0} |",
+            "| {title} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} |",
             r.count,
             r.total.flip_mean,
             r.total.relative_mse,
@@ -129,7 +136,7 @@ pub fn markdown<'a>(
             r.lighting.relative_mse,
             r.shape.flip_mean,
             r.shape.relative_mse,
-            r.gpu_ms
+            r.noise_floor.flip_mean
         );
     }
 }

@@ -3,12 +3,11 @@
 //! no volumetric twin to trace (a sprite is a picture, not a density), so there is one error: what
 //! a user sees.
 
-use super::render_with;
+use super::measure::Measurement;
 use crate::compare::Comparison;
 use anyhow::Result;
 use cloudscape::gpu::GpuContext;
 use cloudscape::image::HdrImage;
-use cloudscape::scene::{SceneDocument, Technique};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -22,27 +21,29 @@ pub struct SpriteRow {
     pub first_frame_ms: f64,
 }
 
-/// Renders the scene with sprites and compares it with the field's reference `field`; writes the
-/// images beside the ray marcher's.
+/// The sprite render `m` against the field's reference `field`; writes the images beside the ray
+/// marcher's.
 pub fn row(
     name: &str,
-    doc: &SceneDocument,
+    m: &mut Measurement,
     ctx: &GpuContext,
     (field, images): (&HdrImage, &Path),
 ) -> Result<SpriteRow> {
-    let (mut renderer, _, gpu, first_frame_ms) = render_with(doc, ctx, Technique::Sprites)?;
     let image = |kind: &str| images.join(format!("{name}-{kind}.png"));
-    let total = Comparison::of(field, &gpu.hdr, Some(&image("sprites-flip")))?;
-    gpu.ldr.write_png(&image("sprites"))?;
-    let sprites = renderer
+    m.write_images(field, &image("sprites"), &image("sprites-flip"))?;
+    let sprites = m
+        .renderer
         .stats(ctx)
         .and_then(|s| s.primitives)
         .unwrap_or_default();
-    eprintln!("sprites: {sprites} drawn, HDR-FLIP {:.4}", total.flip_mean);
+    eprintln!(
+        "sprites: {sprites} drawn, HDR-FLIP {:.4}",
+        m.comparison.flip_mean
+    );
     Ok(SpriteRow {
-        total,
+        total: m.comparison.clone(),
         sprites,
-        first_frame_ms,
+        first_frame_ms: m.first_frame_ms,
     })
 }
 

@@ -6,6 +6,7 @@
 //! dimensions, channel count u32, `dims product x channels` f16 values, then the FNV-1a hash
 //! (u64) of every byte before it.
 
+use crate::stable_hash::{StableHasher, fnv1a};
 use half::f16;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -132,7 +133,7 @@ impl TableFile {
         for v in &self.values {
             bytes.extend_from_slice(&v.to_bits().to_le_bytes());
         }
-        let checksum = fnv1a(FNV_OFFSET, &bytes);
+        let checksum = fnv1a(&bytes);
         bytes.extend_from_slice(&checksum.to_le_bytes());
         bytes
     }
@@ -173,7 +174,7 @@ impl TableFile {
         }
         let body = &bytes[..expected - 8];
         let stored = u64::from_le_bytes(bytes[expected - 8..].try_into().expect("8 bytes"));
-        if fnv1a(FNV_OFFSET, body) != stored {
+        if fnv1a(body) != stored {
             return Err(TableProblem::Corrupt);
         }
         if u32_at(bytes, 12) != kind.code() {
@@ -223,31 +224,20 @@ fn u32_at(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"))
 }
 
-const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
-const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
-
-/// 64-bit FNV-1a (Fowler, Noll & Vo): stable across platforms and runs, unlike std's hasher.
-fn fnv1a(mut hash: u64, bytes: &[u8]) -> u64 {
-    for b in bytes {
-        hash ^= u64::from(*b);
-        hash = hash.wrapping_mul(FNV_PRIME);
-    }
-    hash
-}
-
 /// Builds a table key from its inputs, each written in a fixed byte order.
-pub struct KeyHasher(u64);
+pub struct KeyHasher(StableHasher);
 
 impl KeyHasher {
     /// A key for the table called `name`, under the current [`BAKE_VERSION`].
     pub fn new(name: &str) -> KeyHasher {
-        let hash = fnv1a(FNV_OFFSET, name.as_bytes());
-        KeyHasher(fnv1a(hash, &BAKE_VERSION.to_le_bytes()))
+        let mut hasher = StableHasher::new();
+        hasher.bytes(name.as_bytes()).u32(BAKE_VERSION);
+        KeyHasher(hasher)
     }
 
     /// Adds an integer input.
     pub fn u32(&mut self, v: u32) {
-        self.0 = fnv1a(self.0, &v.to_le_bytes());
+        self.0.u32(v);
     }
 
     /// Adds a float input (by its bits).
@@ -257,7 +247,7 @@ impl KeyHasher {
 
     /// The key.
     pub fn finish(&self) -> u64 {
-        self.0
+        self.0.finish()
     }
 }
 
