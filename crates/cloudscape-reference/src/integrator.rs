@@ -110,6 +110,14 @@ impl<M: Medium> PathTracer<M> {
         env.through_haze(self.path_radiance(vertex, rng), dir, distance_m)
     }
 
+    /// One estimate of the source function at `position` for light leaving toward `-dir`: the
+    /// radiance the medium there scatters per unit extinction (the single-scattering albedo times
+    /// the phase-weighted incident radiance), every order included. It is what a ray marcher's
+    /// sample adds per unit optical depth, and what its lighting models are fitted to.
+    pub fn source_radiance(&self, position: Vec3, dir: Vec3, rng: &mut Rng) -> Vec3 {
+        self.path_radiance(Vertex::Medium { position, dir }, rng)
+    }
+
     /// Radiance leaving `vertex` toward where the path came from.
     fn path_radiance(&self, mut vertex: Vertex, rng: &mut Rng) -> Vec3 {
         let mut throughput = Vec3::ONE;

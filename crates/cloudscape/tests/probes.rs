@@ -6,7 +6,7 @@
 use cloudscape::environment::{Environment, ViewedEnvironment};
 use cloudscape::frame::{DepthConvention, Frame};
 use cloudscape::gpu::GpuContext;
-use cloudscape::optics::{PhaseLobes, diffuse_transmittance};
+use cloudscape::optics::{PhaseLobes, diffuse_transmittance, two_stream_share_from_below};
 use cloudscape::post::tonemap;
 use cloudscape::probe::{Probe, ProbeFunction, ProbeInput};
 use cloudscape::renderer::{CloudRenderer, Reuse};
@@ -274,6 +274,26 @@ fn analytic_environment_functions_match_the_cpu() {
         .map(|t| Vec4::splat(diffuse_transmittance(t.a.x, frame.cloud_mean_cosine)))
         .collect();
     assert_close("diffuse transmittance", &got, &want, 1e-5);
+    let pairs: Vec<ProbeInput> = (0..50)
+        .map(|i| {
+            let taus = Vec4::new(100.0 * unit(i, 15), 100.0 * unit(i, 16), 0.0, 0.0);
+            input(taus, Vec4::ZERO)
+        })
+        .collect();
+    let got = gpu(
+        &ctx,
+        &clouds,
+        ProbeFunction::TwoStreamShareFromBelow,
+        &pairs,
+    );
+    let want: Vec<Vec4> = pairs
+        .iter()
+        .map(|t| {
+            let g = frame.cloud_mean_cosine;
+            Vec4::splat(two_stream_share_from_below(t.a.x, t.a.y, g))
+        })
+        .collect();
+    assert_close("two-stream share from below", &got, &want, 1e-5);
 }
 
 /// Directions around the sun disc's edge as well as all over the sky, and probe inputs of them.

@@ -74,3 +74,12 @@ fn frame_pixel_jitter(pixel: vec2<u32>, index: u32) -> f32 {
 fn frame_diffuse_transmittance(tau: f32) -> f32 {
     return 1.0 / (1.0 + 0.75 * (1.0 - frame.cloud_mean_cosine) * tau);
 }
+
+// The share of the light from below in the mean diffuse radiance inside a conservatively
+// scattering slab lit from above and below, tau_above under its top and tau_below over its bottom:
+// (k tau_above + 1/2) / (1 + k (tau_above + tau_below)), k = 3/4 (1 - g), the two-stream
+// solution. optics::two_stream_share_from_below.
+fn frame_two_stream_share_from_below(tau_above: f32, tau_below: f32) -> f32 {
+    let k = 0.75 * (1.0 - frame.cloud_mean_cosine);
+    return (k * tau_above + 0.5) / (1.0 + k * (tau_above + tau_below));
+}

@@ -339,7 +339,8 @@ fn particle_segment(p: Particle, o: vec3<f32>, d: vec3<f32>, t_max: f32, light: 
     let single = min(sm.x / reference_opacity, render.albedo);
     let multiple = min(sm.y / reference_opacity, 1.0 / PI);
     let sun = light.sun * (light.phase * single * exp(-p.sun_optical_depth) + multiple * exp(-MULTIPLE_OCCLUSION * p.sun_optical_depth));
-    let ambient = 0.5 * render.ambient_scale * (light.sky_above * frame_diffuse_transmittance(p.optical_depth_up) + light.from_below * frame_diffuse_transmittance(p.optical_depth_down));
+    let share_from_below = frame_two_stream_share_from_below(p.optical_depth_up, p.optical_depth_down);
+    let ambient = render.ambient_scale * mix(light.sky_above, light.from_below, share_from_below);
     return Segment(near_m, far_m, optical_depth, sun + render.albedo * ambient);
 }
 

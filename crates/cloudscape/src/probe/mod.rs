@@ -57,6 +57,8 @@ pub enum ProbeFunction {
     CloudSunOpticalDepth = 18,
     /// `environment_cloud_sky_optical_depth(a.xyz)`: `CloudShadowMap::optical_depth(p, 1)`.
     CloudSkyOpticalDepth = 19,
+    /// `frame_two_stream_share_from_below(a.x, a.y)`: `optics::two_stream_share_from_below`.
+    TwoStreamShareFromBelow = 20,
 }
 
 /// The inputs of one evaluation.

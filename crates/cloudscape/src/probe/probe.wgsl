@@ -37,6 +37,7 @@ fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
         case 17u: { return vec4<f32>(environment_sky_mean_radiance_up(a.xyz), 0.0); }
         case 18u: { return vec4<f32>(environment_cloud_sun_optical_depth(a.xyz)); }
         case 19u: { return vec4<f32>(environment_cloud_sky_optical_depth(a.xyz)); }
+        case 20u: { return vec4<f32>(frame_two_stream_share_from_below(a.x, a.y)); }
         default: { return vec4<f32>(-1.0); }
     }
 }

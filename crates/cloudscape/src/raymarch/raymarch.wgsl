@@ -64,10 +64,10 @@ fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
     return field_optical_depth_coarse(p, sun, vec3<f32>(0.0, length_m, 2.0), march.light_steps, jitter);
 }
 
-// Light scattered from the sky above and the ground below, per unit sigma_s: each hemisphere
-// contributes half its mean radiance (isotropic estimate), dimmed by the diffuse transmittance of
-// the cloud between the point and the top (bottom) of the layer, its optical depth estimated from
-// one sample halfway.
+// Light scattered from the sky above and the ground below, per unit sigma_s: the mean diffuse
+// radiance of the two-stream solution for a slab lit by the sky's mean radiance from above and the
+// radiance from below (frame_two_stream_share_from_below), the optical depths to the top and the
+// bottom of the layer estimated from one sample halfway.
 fn march_ambient(p: vec3<f32>, h: f32, light: MarchLight) -> vec3<f32> {
     let up = field_up(p);
     var above = 500.0;
@@ -78,9 +78,8 @@ fn march_ambient(p: vec3<f32>, h: f32, light: MarchLight) -> vec3<f32> {
     }
     let tau_up = field_extinction_coarse(p + up * (0.5 * above)) * above;
     let tau_down = field_extinction_coarse(p - up * (0.5 * below)) * below;
-    let from_above = light.sky_above * frame_diffuse_transmittance(tau_up);
-    let from_below = light.from_below * frame_diffuse_transmittance(tau_down);
-    return march.ambient_scale * 0.5 * (from_above + from_below);
+    let share_from_below = frame_two_stream_share_from_below(tau_up, tau_down);
+    return march.ambient_scale * mix(light.sky_above, light.from_below, share_from_below);
 }
 
 // The light around one ray's clouds, from the environment interface: the sun's irradiance, the
