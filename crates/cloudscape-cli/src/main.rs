@@ -6,6 +6,7 @@ mod bench;
 mod common;
 mod compare;
 mod export;
+mod interrupt;
 mod reference;
 mod render;
 mod report;
@@ -46,6 +47,10 @@ enum Command {
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
+    if let Err(e) = interrupt::install() {
+        eprintln!("error: {e:#}");
+        return std::process::ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Command::Render(args) => render::run(args),
         Command::Export(args) => export::run(args),

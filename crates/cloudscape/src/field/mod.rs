@@ -11,6 +11,7 @@ mod layer;
 pub mod noise;
 pub mod profile;
 pub mod texture;
+mod vol_file;
 pub mod voxel;
 pub mod weather;
 
@@ -183,7 +184,12 @@ impl CloudField {
             .iter()
             .enumerate()
             .map(|(i, v)| {
-                let mut grid = VoxelGrid::read_vol(&resolve(&v.path))
+                let policy = if v.sanitize {
+                    voxel::ValuePolicy::Replace
+                } else {
+                    voxel::ValuePolicy::Reject
+                };
+                let mut grid = VoxelGrid::read_vol_with(&resolve(&v.path), policy)
                     .map_err(|e| err(&format!("volumes.{i}.path"), e.to_string()))?;
                 grid.values
                     .iter_mut()
