@@ -21,8 +21,11 @@ use cloudscape::sprites::file::ModelFile;
 /// Whether a reader accepted the input, or its error message.
 pub type Outcome = Result<(), String>;
 
+/// A target's entry point.
+pub type Target = fn(&[u8]) -> Outcome;
+
 /// Every target by name, as `fuzz_targets/` and `tests/fuzz-regressions/` name them.
-pub const TARGETS: [(&str, fn(&[u8]) -> Outcome); 6] = [
+pub const TARGETS: [(&str, Target); 6] = [
     ("scene", scene),
     ("vol", vol),
     ("weather_png", weather_png),
@@ -119,13 +122,17 @@ pub fn metar(data: &[u8]) -> Outcome {
     let text = std::str::from_utf8(data).map_err(|e| e.to_string())?;
     let report = metar::parse(text).map_err(|e| e.to_string())?;
     let weather = SceneWeather::from_report(&report);
-    assert!(weather.visibility_m.is_none_or(|v| v.is_finite() && v > 0.0));
+    assert!(
+        weather
+            .visibility_m
+            .is_none_or(|v| v.is_finite() && v > 0.0)
+    );
     if text.contains("'''") || text.contains('\n') || text.contains('\r') {
         return Ok(());
     }
     let toml = format!("[weather]\nmetar = '''{text}'''\n");
-    let doc = SceneDocument::parse(&toml, "fuzz.toml", Path::new("."), &[])
-        .map_err(|e| e.to_string())?;
+    let doc =
+        SceneDocument::parse(&toml, "fuzz.toml", Path::new("."), &[]).map_err(|e| e.to_string())?;
     check_scene(&doc.scene);
     Ok(())
 }

@@ -20,7 +20,9 @@ static PENDING: Mutex<Pending> = Mutex::new(Pending {
 
 fn pending() -> std::sync::MutexGuard<'static, Pending> {
     // A writer that panicked leaves the list as it was: still the files to remove.
-    PENDING.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    PENDING
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
 /// Removes the temporary file of every write in progress and exits the process with `code`
@@ -48,7 +50,7 @@ impl PendingFile {
 
     /// Creates and lists `path`, at once, so that an exit never misses it.
     fn create(path: &Path) -> std::io::Result<(PendingFile, File)> {
-        Self::list_with(path, File::create)
+        Self::list_with(path, |p| File::create(p))
     }
 
     fn list_with<T>(
@@ -244,7 +246,10 @@ mod tests {
         )
         .expect_err("the disk is full");
         assert_eq!(error.raw_os_error(), Some(28));
-        assert!(error.to_string().contains("No space left on device"), "{error}");
+        assert!(
+            error.to_string().contains("No space left on device"),
+            "{error}"
+        );
         assert_eq!(std::fs::read(&path).expect("read"), b"old");
         assert_eq!(dir.entries(), ["out.bin"]);
         assert!(!pending().files.iter().any(|f| f.starts_with(&dir.0)));

@@ -9,6 +9,7 @@ use cloudscape::renderer::SceneRenderer;
 use cloudscape::scene::{Scene, SceneDocument};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
+use std::cell::RefCell;
 use std::path::Path;
 
 /// Technique, sky model, phase model and planet shape of each case: every pair of levels of any
@@ -111,7 +112,7 @@ fn renderer(ctx: &GpuContext) -> SceneRenderer {
 #[test]
 fn random_in_range_scenes_render_only_finite_non_negative_pixels() {
     let ctx = GpuContext::for_tests();
-    let mut renderer = renderer(&ctx);
+    let renderer = RefCell::new(renderer(&ctx));
     for (index, case) in CASES.iter().enumerate() {
         let config = Config {
             cases: 2,
@@ -123,7 +124,7 @@ fn random_in_range_scenes_render_only_finite_non_negative_pixels() {
         let mut runner = TestRunner::new_with_rng(config, rng);
         let result = runner.run(&parameters(), |parameters| {
             let scene = scene(case, &parameters);
-            match first_bad_pixel(&ctx, &mut renderer, &scene) {
+            match first_bad_pixel(&ctx, &mut renderer.borrow_mut(), &scene) {
                 None => Ok(()),
                 Some((i, pixel)) => Err(TestCaseError::fail(format!("pixel {i} is {pixel:?}"))),
             }

@@ -40,9 +40,10 @@ fn failures(target: &str) -> Vec<String> {
             let bytes = std::fs::read(&path).expect("read input");
             match catch_unwind(AssertUnwindSafe(|| entry(&bytes))) {
                 Err(_) => failures.push(format!("{}: panicked", path.display())),
-                Ok(result) if result.is_ok() != expect_ok => {
-                    failures.push(format!("{}: expected {outcome}, got {result:?}", path.display()))
-                }
+                Ok(result) if result.is_ok() != expect_ok => failures.push(format!(
+                    "{}: expected {outcome}, got {result:?}",
+                    path.display()
+                )),
                 Ok(_) => {}
             }
         }

@@ -242,7 +242,10 @@ fn print_and_check(report: &SoakReport, print: bool) -> Result<()> {
         };
         let growth = (end as f64 - start as f64) / (start as f64).max(1.0);
         if print {
-            println!("{name:<26} {start:>14} {end:>14} {:>+8.2} %", growth * 100.0);
+            println!(
+                "{name:<26} {start:>14} {end:>14} {:>+8.2} %",
+                growth * 100.0
+            );
         }
         if growth > MAX_GROWTH {
             failures.push(format!(

@@ -139,7 +139,10 @@ fn ctrl_c_mid_render_stops_and_writes_nothing() {
     args.extend(["--out", "out.exr"]);
     let (status, stderr) = interrupt_after(scratch.path(), &args, "rendering 320x180");
     assert_eq!(status.code(), Some(130), "{stderr}");
-    assert!(stderr.contains("interrupted: stopped; no partial file"), "{stderr}");
+    assert!(
+        stderr.contains("interrupted: stopped; no partial file"),
+        "{stderr}"
+    );
     assert!(scratch.file_names().is_empty());
 }
 
@@ -168,7 +171,10 @@ fn ctrl_c_mid_reference_writes_the_image_so_far() {
     let (status, stderr) = interrupt_after(scratch.path(), &args, "path tracing");
     assert!(status.success(), "{stderr}");
     assert!(stderr.contains("stopped early"), "{stderr}");
-    assert_eq!(scratch.file_names().into_iter().collect::<Vec<_>>(), ["ref.exr"]);
+    assert_eq!(
+        scratch.file_names().into_iter().collect::<Vec<_>>(),
+        ["ref.exr"]
+    );
     let image = HdrImage::read(&scratch.join("ref.exr")).expect("a whole EXR");
     assert_eq!((image.width, image.height), (64, 36));
 }
@@ -190,7 +196,16 @@ fn start_up_without_xdg_runtime_dir_prints_no_wayland_noise() {
 fn a_short_soak_keeps_its_memory_and_reports_it() {
     let scratch = Scratch::new("soak");
     let args = [
-        "bench", "--soak", "300", "--warmup", "2", "--width", "48", "--height", "27", "--set",
+        "bench",
+        "--soak",
+        "300",
+        "--warmup",
+        "2",
+        "--width",
+        "48",
+        "--height",
+        "27",
+        "--set",
         "render.quality=low",
     ];
     let run = cloudscape(scratch.path(), &args, true);

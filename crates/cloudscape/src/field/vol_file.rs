@@ -167,7 +167,6 @@ pub enum VoxelError {
     },
 }
 
-
 impl VoxelGrid {
     /// Reads a `.vol` file, keeping channel 0 of multi-channel files; a value that is not a
     /// density is an error ([`ValuePolicy::Reject`]).
@@ -513,12 +512,22 @@ mod tests {
         for value in [f32::NAN, f32::INFINITY, -1.0e-3, 7.0e4] {
             let error = parse_vol(&with_value(17, value), Path::new("bad.vol")).unwrap_err();
             assert!(
-                matches!(error, VoxelError::BadValue { index: 17, cell: [1, 1, 1], .. }),
+                matches!(
+                    error,
+                    VoxelError::BadValue {
+                        index: 17,
+                        cell: [1, 1, 1],
+                        ..
+                    }
+                ),
                 "{value}: {error}"
             );
             let text = error.to_string();
             assert!(text.starts_with("bad.vol: value"), "{text}");
-            assert!(text.contains("0..65504") && text.contains("sanitize"), "{text}");
+            assert!(
+                text.contains("0..65504") && text.contains("sanitize"),
+                "{text}"
+            );
         }
     }
 

@@ -61,8 +61,8 @@ pub const MAX_WEATHER_DECODE_BYTES: u64 = 512 << 20;
 
 /// Reads a PNG weather map file (cargo feature `png`).
 fn read_png(path: &Path) -> Result<Texture8, String> {
-    let bytes =
-        std::fs::read(path).map_err(|e| format!("cannot read weather map {}: {e}", path.display()))?;
+    let bytes = std::fs::read(path)
+        .map_err(|e| format!("cannot read weather map {}: {e}", path.display()))?;
     Weather::texture_from_png(&bytes, path)
 }
 
@@ -77,10 +77,8 @@ impl Weather {
         limits.max_image_width = Some(MAX_WEATHER_TEXELS);
         limits.max_image_height = Some(MAX_WEATHER_TEXELS);
         limits.max_alloc = Some(MAX_WEATHER_DECODE_BYTES);
-        let mut reader = image::ImageReader::with_format(
-            std::io::Cursor::new(bytes),
-            image::ImageFormat::Png,
-        );
+        let mut reader =
+            image::ImageReader::with_format(std::io::Cursor::new(bytes), image::ImageFormat::Png);
         reader.limits(limits);
         let img = reader.decode().map_err(|e| {
             format!(
@@ -211,7 +209,10 @@ mod tests {
             ..WeatherMap::default()
         };
         let err = Weather::from_scene(&map, Some(&path)).unwrap_err();
-        assert!(err.contains("wide.png") && err.contains("8192x8192"), "{err}");
+        assert!(
+            err.contains("wide.png") && err.contains("8192x8192"),
+            "{err}"
+        );
         let bytes = std::fs::read(&path).unwrap();
         let err = Weather::texture_from_png(&bytes[..60], &path).unwrap_err();
         assert!(err.starts_with("cannot read weather map"), "{err}");

@@ -121,7 +121,10 @@ impl fmt::Display for TableProblem {
             TableProblem::WrongKind => write!(f, "holds another kind of table"),
             TableProblem::Corrupt => write!(f, "is corrupt: its checksum does not match"),
             TableProblem::TooLarge { dims, channels } => {
-                write!(f, "claims {dims:?} entries of {channels} values: too many to hold")
+                write!(
+                    f,
+                    "claims {dims:?} entries of {channels} values: too many to hold"
+                )
             }
             TableProblem::BadValue { index, value } => write!(
                 f,
@@ -205,7 +208,8 @@ impl TableFile {
             });
         }
         let body = &bytes[..expected - 8];
-        if checksum(body) != u64::from_le_bytes(bytes[expected - 8..].try_into().expect("8 bytes")) {
+        if checksum(body) != u64::from_le_bytes(bytes[expected - 8..].try_into().expect("8 bytes"))
+        {
             return Err(TableProblem::Corrupt);
         }
         if u32_at(bytes, 12) != kind.code() {
@@ -222,7 +226,10 @@ impl TableFile {
             .chunks_exact(2)
             .map(|c| f16::from_bits(u16::from_le_bytes([c[0], c[1]])))
             .collect();
-        if let Some(index) = values.iter().position(|v| !(v.is_finite() && v.to_f32() >= 0.0)) {
+        if let Some(index) = values
+            .iter()
+            .position(|v| !(v.is_finite() && v.to_f32() >= 0.0))
+        {
             let value = values[index].to_f32();
             return Err(TableProblem::BadValue { index, value });
         }
@@ -397,7 +404,8 @@ mod tests {
     #[test]
     fn a_bad_value_a_wrong_shape_and_a_huge_header_are_refused() {
         let mut bytes = table().encode();
-        bytes[HEADER_BYTES + 6..HEADER_BYTES + 8].copy_from_slice(&f16::NAN.to_bits().to_le_bytes());
+        bytes[HEADER_BYTES + 6..HEADER_BYTES + 8]
+            .copy_from_slice(&f16::NAN.to_bits().to_le_bytes());
         let decode = |b: &[u8]| TableFile::decode(b, TableKind::Scattering, 42);
         assert!(matches!(
             decode(&resealed(bytes.clone())),
@@ -413,7 +421,12 @@ mod tests {
             })
         );
         let shape = table().expect_shape([3, 2, 2, 1], 1).unwrap_err();
-        assert!(shape.to_string().contains("its key needs [3, 2, 2, 1] of 1"), "{shape}");
+        assert!(
+            shape
+                .to_string()
+                .contains("its key needs [3, 2, 2, 1] of 1"),
+            "{shape}"
+        );
         let mut huge = table().encode();
         huge[24..44].copy_from_slice(&[u32::MAX; 5].map(u32::to_le_bytes).concat());
         assert!(matches!(decode(&huge), Err(TableProblem::TooLarge { .. })));
