@@ -60,7 +60,16 @@ fn interrupt_after(dir: &Path, args: &[&str], cue: &'static str) -> (ExitStatus,
     (status, stderr)
 }
 
-/// Every entry of `dir`, recursively, relative to it.
+/// `first`, then every group of arguments in order.
+fn args<'a>(first: &[&'a str], groups: &[&[&'a str]]) -> Vec<&'a str> {
+    let mut all = first.to_vec();
+    for group in groups {
+        all.extend_from_slice(group);
+    }
+    all
+}
+
+/// Every file under `dir`, recursively.
 fn files_under(dir: &Path) -> Vec<PathBuf> {
     let mut files = Vec::new();
     for entry in std::fs::read_dir(dir).expect("list directory") {
@@ -77,9 +86,7 @@ fn files_under(dir: &Path) -> Vec<PathBuf> {
 #[test]
 fn an_unwritable_output_path_is_named_and_nothing_is_written() {
     let scratch = Scratch::new("unwritable");
-    let mut args = vec!["render"];
-    args.extend(TINY);
-    args.extend(["--out", "no-such-dir/out.png"]);
+    let args = args(&["render"], &[&TINY, &["--out", "no-such-dir/out.png"]]);
     let run = cloudscape(scratch.path(), &args, true);
     assert!(!run.success, "{}", run.stderr);
     assert!(
@@ -118,9 +125,7 @@ fn a_full_disk_is_reported_and_leaves_no_partial_file() {
     let disk = TinyDisk::mount(4);
     let out = disk.0.join("out.exr");
     let out = out.to_str().expect("a UTF-8 path");
-    let mut args = vec!["render"];
-    args.extend(TINY);
-    args.extend(["--out", out]);
+    let args = args(&["render"], &[&TINY, &["--out", out]]);
     let run = cloudscape(Path::new("."), &args, true);
     assert!(!run.success, "{}", run.stderr);
     assert!(
@@ -134,9 +139,7 @@ fn a_full_disk_is_reported_and_leaves_no_partial_file() {
 #[test]
 fn ctrl_c_mid_render_stops_and_writes_nothing() {
     let scratch = Scratch::new("interrupt-render");
-    let mut args = vec!["render"];
-    args.extend(SLOW);
-    args.extend(["--out", "out.exr"]);
+    let args = args(&["render"], &[&SLOW, &["--out", "out.exr"]]);
     let (status, stderr) = interrupt_after(scratch.path(), &args, "rendering 320x180");
     assert_eq!(status.code(), Some(130), "{stderr}");
     assert!(
@@ -149,8 +152,7 @@ fn ctrl_c_mid_render_stops_and_writes_nothing() {
 #[test]
 fn ctrl_c_mid_animate_leaves_only_whole_frames() {
     let scratch = Scratch::new("interrupt-animate");
-    let mut args = vec!["animate", "--frames", "50", "--out", "frames"];
-    args.extend(SLOW);
+    let args = args(&["animate", "--frames", "50", "--out", "frames"], &[&SLOW]);
     let (status, stderr) = interrupt_after(scratch.path(), &args, "adapter:");
     assert_eq!(status.code(), Some(130), "{stderr}");
     assert!(stderr.contains("interrupted"), "{stderr}");
@@ -165,9 +167,10 @@ fn ctrl_c_mid_animate_leaves_only_whole_frames() {
 #[test]
 fn ctrl_c_mid_reference_writes_the_image_so_far() {
     let scratch = Scratch::new("interrupt-reference");
-    let mut args = vec!["reference", "--spp", "100000", "--pass-spp", "1"];
-    args.extend(TINY);
-    args.extend(["--out", "ref.exr"]);
+    let args = args(
+        &["reference", "--spp", "100000", "--pass-spp", "1"],
+        &[&TINY, &["--out", "ref.exr"]],
+    );
     let (status, stderr) = interrupt_after(scratch.path(), &args, "path tracing");
     assert!(status.success(), "{stderr}");
     assert!(stderr.contains("stopped early"), "{stderr}");
@@ -182,9 +185,7 @@ fn ctrl_c_mid_reference_writes_the_image_so_far() {
 #[test]
 fn start_up_without_xdg_runtime_dir_prints_no_wayland_noise() {
     let scratch = Scratch::new("no-xdg");
-    let mut args = vec!["render"];
-    args.extend(TINY);
-    args.extend(["--out", "out.png"]);
+    let args = args(&["render"], &[&TINY, &["--out", "out.png"]]);
     let mut command = command(scratch.path(), &args, true);
     command.env_remove("XDG_RUNTIME_DIR");
     let run = run(command);

@@ -96,10 +96,15 @@ pub(super) fn cell_count(resolution: [u32; 3]) -> Option<usize> {
 pub(super) mod tests {
     use super::*;
 
+    /// A linear ramp, positive over the box of [`ramp_grid`].
+    fn ramp(p: Vec3) -> f32 {
+        p.x + 2.0 * p.y - 0.5 * p.z + 200.0
+    }
+
     /// A 4x3x2 grid of a linear ramp over a box off the origin.
     pub(crate) fn ramp_grid() -> VoxelGrid {
         let (min, max) = (Vec3::new(-100.0, 0.0, 50.0), Vec3::new(100.0, 400.0, 250.0));
-        VoxelGrid::from_fn([4, 3, 2], min, max, |p| p.x + 2.0 * p.y - 0.5 * p.z)
+        VoxelGrid::from_fn([4, 3, 2], min, max, ramp)
     }
 
     #[test]
@@ -107,7 +112,7 @@ pub(super) mod tests {
         let grid = ramp_grid();
         // Cell [1, 2, 1]: centre x = -100 + 1.5 * 50, y = 2.5 * 400 / 3, z = 50 + 1.5 * 100.
         let centre = Vec3::new(-25.0, 1000.0 / 3.0, 200.0);
-        let expected = centre.x + 2.0 * centre.y - 0.5 * centre.z;
+        let expected = ramp(centre);
         assert!((grid.values[(3 + 2) * 4 + 1] - expected).abs() < 1e-3);
         assert_eq!(grid.value([1, 2, 1]), grid.values[(3 + 2) * 4 + 1]);
     }
