@@ -50,5 +50,6 @@ fn trace(scene: &Scene) -> Result<(), String> {
 
 #[test]
 fn random_in_range_scenes_trace_only_finite_non_negative_radiance() {
+    let _noise = random_scenes::noise_holder();
     random_scenes::check_cases(&CASES, 101, fixed, trace);
 }

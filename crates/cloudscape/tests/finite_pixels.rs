@@ -55,6 +55,7 @@ fn render(ctx: &GpuContext, renderer: &mut SceneRenderer, scene: &Scene) -> Vec<
 #[test]
 fn random_in_range_scenes_render_only_finite_non_negative_pixels() {
     let ctx = GpuContext::for_tests();
+    let _noise = random_scenes::noise_holder();
     let first = random_scenes::scene(&fixed(&CASES[0]));
     let renderer = SceneRenderer::new(&ctx, &first, Path::new(".")).expect("the field builds");
     let renderer = RefCell::new(renderer);

@@ -3,6 +3,7 @@
 //! from its documented range (`default.toml`) by proptest with fixed seeds, so runs repeat and a
 //! failure shrinks to a minimal scene.
 
+use cloudscape::field::CloudField;
 use cloudscape::scene::{Scene, SceneDocument};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
@@ -49,6 +50,14 @@ pub fn scene(overrides: &[String]) -> Scene {
     SceneDocument::parse("", "case.toml", Path::new("."), overrides)
         .unwrap_or_else(|e| panic!("{e}"))
         .scene
+}
+
+/// A field of the default noise, baked and held: while it lives, every field the cases build
+/// shares its noise rather than baking its own (the drawn parameters leave the noise seed alone).
+pub fn noise_holder() -> CloudField {
+    let field = CloudField::new(&scene(&[]), Path::new(".")).expect("the default field builds");
+    field.bake_noise();
+    field
 }
 
 /// Runs `check` on [`DRAWS`] scenes per case, each made of `fixed(case)` and random parameters,
