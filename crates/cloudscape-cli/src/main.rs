@@ -10,6 +10,7 @@ mod interrupt;
 mod reference;
 mod render;
 mod report;
+mod runtime_dir;
 
 use clap::{Parser, Subcommand};
 
@@ -46,6 +47,7 @@ enum Command {
 }
 
 fn main() -> std::process::ExitCode {
+    runtime_dir::ensure();
     let cli = Cli::parse();
     if let Err(e) = interrupt::install() {
         eprintln!("error: {e:#}");

@@ -55,6 +55,21 @@ impl Snapshot {
         }
     }
 
+    /// The figures in one line, MiB.
+    fn line(&self) -> String {
+        let mib = |bytes: Option<u64>| {
+            bytes.map_or("n/a".into(), |b| format!("{:.1}", b as f64 / 1048576.0))
+        };
+        format!(
+            "resident {} MiB, GPU allocated {} MiB, {} live wgpu objects",
+            mib(self.resident_bytes),
+            mib(self.gpu.allocated_bytes),
+            self.gpu
+                .live_objects
+                .map_or("n/a".into(), |n| n.to_string())
+        )
+    }
+
     /// Each figure by name, `None` where it is not known.
     fn figures(&self) -> [(&'static str, Option<u64>); 4] {
         [
@@ -171,7 +186,8 @@ impl<'a> Soak<'a> {
     ) -> Result<()> {
         let reuse = temporal_reuse(self.args.temporal.unwrap_or(4));
         for i in 0..count {
-            if bar.is_some() && i > 0 && i % CHANGE_EVERY == 0 {
+            if let Some(bar) = bar.filter(|_| i > 0 && i % CHANGE_EVERY == 0) {
+                bar.println(format!("frame {i}: {}", Snapshot::take(ctx).line()));
                 self.edit(ctx, self.edits as usize)?;
             }
             let frame = self.moving_frame();
