@@ -6,9 +6,11 @@ mod bench;
 mod common;
 mod compare;
 mod export;
+mod interrupt;
 mod reference;
 mod render;
 mod report;
+mod runtime_dir;
 
 use clap::{Parser, Subcommand};
 
@@ -45,7 +47,12 @@ enum Command {
 }
 
 fn main() -> std::process::ExitCode {
+    runtime_dir::ensure();
     let cli = Cli::parse();
+    if let Err(e) = interrupt::install() {
+        eprintln!("error: {e:#}");
+        return std::process::ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Command::Render(args) => render::run(args),
         Command::Export(args) => export::run(args),

@@ -1,14 +1,13 @@
 //! `cloudscape reference`: the path-traced ground truth of a scene, progressive and stoppable.
 
 use crate::common::{SceneArgs, Stages, progress_bar};
+use crate::interrupt;
 use anyhow::{Result, anyhow};
 use clap::Args;
 use cloudscape::image::write_image;
 use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer, ProgressiveRender, RenderStats};
 use glam::UVec2;
 use std::path::PathBuf;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// Arguments of `cloudscape reference`.
@@ -49,10 +48,10 @@ pub fn run(args: ReferenceArgs) -> Result<()> {
         "path tracing {}x{} at {} spp (majorant grid {}x{}x{})",
         size.x, size.y, args.spp, grid.x, grid.y, grid.z
     );
-    let stop = interrupt_flag()?;
+    interrupt::stop_gracefully();
     let deadline = args.time_budget.and_then(deadline_after);
     let should_stop =
-        || stop.load(Ordering::Relaxed) || deadline.is_some_and(|d| Instant::now() >= d);
+        || interrupt::stop_requested() || deadline.is_some_and(|d| Instant::now() >= d);
     let mut render = ProgressiveRender::new(&tracer, args.seed);
     let bar = progress_bar("tracing");
     bar.set_length(u64::from(args.spp) * u64::from(size.x) * u64::from(size.y));
@@ -89,14 +88,6 @@ pub fn run(args: ReferenceArgs) -> Result<()> {
 pub fn deadline_after(seconds: f64) -> Option<Instant> {
     let budget = Duration::try_from_secs_f64(seconds.max(0.0)).ok()?;
     Instant::now().checked_add(budget)
-}
-
-/// A flag that Ctrl-C raises.
-fn interrupt_flag() -> Result<Arc<AtomicBool>> {
-    let flag = Arc::new(AtomicBool::new(false));
-    let raised = Arc::clone(&flag);
-    ctrlc::set_handler(move || raised.store(true, Ordering::Relaxed))?;
-    Ok(flag)
 }
 
 fn print_stats(stats: &RenderStats, size: UVec2) {

@@ -1,9 +1,86 @@
-//! File-system helpers shared by every module that writes files.
+//! File-system helpers shared by every module that writes files: every file appears whole or not
+//! at all, also when the process is interrupted ([`exit_abandoning_writes`]).
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
+
+/// The temporary files being written now, and whether the process is exiting.
+struct Pending {
+    files: Vec<PathBuf>,
+    exiting: bool,
+}
+
+static PENDING: Mutex<Pending> = Mutex::new(Pending {
+    files: Vec::new(),
+    exiting: false,
+});
+
+fn pending() -> std::sync::MutexGuard<'static, Pending> {
+    // A writer that panicked leaves the list as it was: still the files to remove.
+    PENDING
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// Removes the temporary file of every write in progress and exits the process with `code`
+/// before any of them can complete (a host's Ctrl-C handler): the files being written are then
+/// left as they were, never partial.
+pub fn exit_abandoning_writes(code: i32) -> ! {
+    let mut pending = pending();
+    pending.exiting = true;
+    for file in pending.files.drain(..) {
+        let _ = std::fs::remove_file(file);
+    }
+    std::process::exit(code)
+}
+
+/// A temporary file being written: listed, so that [`exit_abandoning_writes`] removes it, until
+/// dropped. Writers that hand a temporary file to another process (an encoder) list it too.
+pub struct PendingFile(PathBuf);
+
+impl PendingFile {
+    /// Lists `path`, a temporary file that another process creates and writes. Fails with
+    /// [`std::io::ErrorKind::Interrupted`] once the process is exiting.
+    pub fn list(path: &Path) -> std::io::Result<PendingFile> {
+        Self::list_with(path, |_| Ok(())).map(|(pending, ())| pending)
+    }
+
+    /// Creates and lists `path`, at once, so that an exit never misses it.
+    fn create(path: &Path) -> std::io::Result<(PendingFile, File)> {
+        Self::list_with(path, |p| File::create(p))
+    }
+
+    fn list_with<T>(
+        path: &Path,
+        make: impl FnOnce(&Path) -> std::io::Result<T>,
+    ) -> std::io::Result<(PendingFile, T)> {
+        let mut pending = pending();
+        if pending.exiting {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::Interrupted,
+                "the process is exiting",
+            ));
+        }
+        let made = make(path)?;
+        pending.files.push(path.to_path_buf());
+        Ok((PendingFile(path.to_path_buf()), made))
+    }
+
+    /// Renames the file to `target`, unless an exit has removed it first.
+    pub fn rename_to(&self, target: &Path) -> std::io::Result<()> {
+        let _pending = pending();
+        std::fs::rename(&self.0, target)
+    }
+}
+
+impl Drop for PendingFile {
+    fn drop(&mut self) {
+        pending().files.retain(|f| *f != self.0);
+    }
+}
 
 /// Runs `write` on a temporary file beside `path`, then flushes, syncs and renames it over
 /// `path`, so that readers never see a partial file. On any error the temporary file is removed
@@ -17,11 +94,12 @@ pub(crate) fn write_atomically<E>(
     write: impl FnOnce(&mut BufWriter<File>) -> Result<(), E>,
 ) -> Result<(), E> {
     let temporary = temporary_path(path);
-    let result = write_and_close(&temporary, &io_error, write)
-        .and_then(|()| std::fs::rename(&temporary, path).map_err(&io_error));
+    let (pending, file) = PendingFile::create(&temporary).map_err(&io_error)?;
+    let result = write_and_close(file, &io_error, write)
+        .and_then(|()| pending.rename_to(path).map_err(&io_error));
     if result.is_err() {
-        // The temporary file is ours and incomplete (or was never created); a failure to remove
-        // it cannot make the outcome worse.
+        // The temporary file is ours and incomplete; a failure to remove it cannot make the
+        // outcome worse.
         let _ = std::fs::remove_file(&temporary);
     }
     result
@@ -43,14 +121,13 @@ fn temporary_path(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.{unique}.tmp", std::process::id()))
 }
 
-/// Creates `temporary`, runs `write` on it, and flushes, syncs and closes it (a file must be
-/// closed before it is renamed on some systems).
+/// Runs `write` on `file`, and flushes, syncs and closes it (a file must be closed before it is
+/// renamed on some systems).
 fn write_and_close<E>(
-    temporary: &Path,
+    file: File,
     io_error: impl Fn(std::io::Error) -> E,
     write: impl FnOnce(&mut BufWriter<File>) -> Result<(), E>,
 ) -> Result<(), E> {
-    let file = File::create(temporary).map_err(&io_error)?;
     let mut writer = BufWriter::new(file);
     write(&mut writer)?;
     let file = writer
@@ -130,6 +207,52 @@ mod tests {
         assert_eq!(result, Err("encoder failed".to_string()));
         assert_eq!(std::fs::read(&path).expect("read"), b"old");
         assert_eq!(dir.entries(), ["out.bin"]);
+    }
+
+    /// A writer that takes `capacity` bytes and then fails as a full disk does.
+    struct FullDisk<'a> {
+        inner: &'a mut dyn Write,
+        capacity: usize,
+    }
+
+    impl Write for FullDisk<'_> {
+        fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+            if self.capacity == 0 {
+                return Err(std::io::Error::from_raw_os_error(28)); // ENOSPC
+            }
+            let n = bytes.len().min(self.capacity);
+            self.capacity -= n;
+            self.inner.write(&bytes[..n])
+        }
+
+        fn flush(&mut self) -> std::io::Result<()> {
+            self.inner.flush()
+        }
+    }
+
+    #[test]
+    fn a_full_disk_part_way_keeps_the_old_file_and_says_so() {
+        let (dir, path) = with_old_file("fsutil-full");
+        let error = write_atomically(
+            &path,
+            |error| error,
+            |file| {
+                let mut disk = FullDisk {
+                    inner: file,
+                    capacity: 1000,
+                };
+                disk.write_all(&[7; 5000])
+            },
+        )
+        .expect_err("the disk is full");
+        assert_eq!(error.raw_os_error(), Some(28));
+        assert!(
+            error.to_string().contains("No space left on device"),
+            "{error}"
+        );
+        assert_eq!(std::fs::read(&path).expect("read"), b"old");
+        assert_eq!(dir.entries(), ["out.bin"]);
+        assert!(!pending().files.iter().any(|f| f.starts_with(&dir.0)));
     }
 
     #[test]

@@ -19,7 +19,7 @@ pub mod environment;
 pub mod export;
 pub mod field;
 pub mod frame;
-mod fsutil;
+pub mod fsutil;
 pub mod gpu;
 pub mod image;
 pub mod optics;

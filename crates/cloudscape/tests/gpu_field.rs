@@ -124,6 +124,7 @@ fn gpu_voxel_density_equals_cpu_field() {
         center_m: [100.0, 2000.0, -300.0],
         size_m: [1200.0, 800.0, 1000.0],
         extinction_per_m: 0.08,
+        ..VolumeGrid::default()
     };
     let min = Vec3::from_array(volume.center_m) - Vec3::from_array(volume.size_m) * 0.55;
     let max = Vec3::from_array(volume.center_m) + Vec3::from_array(volume.size_m) * 0.55;

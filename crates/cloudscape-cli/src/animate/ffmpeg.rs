@@ -1,6 +1,7 @@
 //! An MP4 preview encoded by `ffmpeg`, when it is on PATH, from display frames piped to it.
 
 use anyhow::{Context, Result, anyhow};
+use cloudscape::fsutil::PendingFile;
 use cloudscape::image::LdrImage;
 use glam::UVec2;
 use std::io::{Read, Write};
@@ -14,6 +15,8 @@ pub struct Mp4Writer {
     child: Child,
     stdin: Option<ChildStdin>,
     temporary: PathBuf,
+    /// Lists the temporary file, so that Ctrl-C removes it.
+    pending: PendingFile,
     path: PathBuf,
 }
 
@@ -23,6 +26,7 @@ impl Mp4Writer {
     pub fn start(path: &Path, size: UVec2, fps: f32) -> Result<Option<Mp4Writer>> {
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
         let temporary = path.with_file_name(format!(".{}.partial", name.unwrap_or_default()));
+        let pending = PendingFile::list(&temporary).context("starting ffmpeg")?;
         let spawned = Command::new("ffmpeg")
             .args(["-hide_banner", "-nostats", "-loglevel", "error", "-y"])
             .args(["-f", "rawvideo", "-pix_fmt", "rgba"])
@@ -49,6 +53,7 @@ impl Mp4Writer {
             stdin: child.stdin.take(),
             child,
             temporary,
+            pending,
             path: path.to_path_buf(),
         }))
     }
@@ -73,7 +78,8 @@ impl Mp4Writer {
         if !status.success() {
             return Err(anyhow!("ffmpeg failed ({status}): {}", messages.trim()));
         }
-        std::fs::rename(&self.temporary, &self.path)
+        self.pending
+            .rename_to(&self.path)
             .with_context(|| format!("moving the MP4 to {}", self.path.display()))?;
         Ok(self.path.clone())
     }

@@ -3,6 +3,7 @@
 //! animated sequence ([`flythrough`]).
 
 mod flythrough;
+mod soak;
 
 use crate::common::{GpuArgs, SceneArgs, parse_divisor, temporal_reuse};
 use anyhow::{Result, anyhow};
@@ -41,6 +42,12 @@ pub struct BenchArgs {
     /// (repeatable).
     #[arg(long, value_name = "KEY=VALUE,...")]
     variant: Vec<String>,
+    /// Soak: render this many frames at a small size (160x90 unless --width/--height) with
+    /// temporal reuse, a moving camera and a live edit every 250 frames, and fail if resident
+    /// or GPU memory grows over 1 % from the warm-up to the end.
+    #[arg(long, value_name = "FRAMES", conflicts_with = "flythrough",
+          value_parser = clap::value_parser!(u32).range(1..))]
+    soak: Option<u32>,
     #[command(flatten)]
     flythrough: flythrough::FlythroughArgs,
     #[command(flatten)]
@@ -88,9 +95,12 @@ struct Report {
     primitives: Option<u32>,
 }
 
-/// Runs the fly-through measurement with `--flythrough`, the repeated-frame timing otherwise.
+/// Runs the soak with `--soak`, the fly-through measurement with `--flythrough`, the
+/// repeated-frame timing otherwise.
 pub fn run(args: BenchArgs) -> Result<()> {
-    if args.flythrough.flythrough {
+    if let Some(frames) = args.soak {
+        soak::run(&args, frames)
+    } else if args.flythrough.flythrough {
         flythrough::run(args)
     } else {
         run_repeated(args)

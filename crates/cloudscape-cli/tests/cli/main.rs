@@ -8,5 +8,6 @@
 mod animate;
 mod bake;
 mod commands;
+mod faults;
 mod reference;
 mod support;

@@ -11,6 +11,7 @@ mod layer;
 pub mod noise;
 pub mod profile;
 pub mod texture;
+mod vol_file;
 pub mod voxel;
 pub mod weather;
 
@@ -23,7 +24,7 @@ pub use weather::Weather;
 use crate::scene::{NoiseSettings, PlanetShape, Scene};
 use glam::{Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::sync::{Arc, Mutex, OnceLock, Weak};
 
 /// `(sqrt(5) - 1) / 2`: successive multiples modulo 1 spread evenly (Weyl's sequence), so the
 /// segments of a light path sample decorrelated offsets.
@@ -105,7 +106,7 @@ impl PlanetGeometry {
 struct NoiseSource {
     kind: NoiseKind,
     seed: u32,
-    baked: OnceLock<Texture8>,
+    baked: OnceLock<Arc<Texture8>>,
 }
 
 impl NoiseSource {
@@ -127,8 +128,34 @@ impl NoiseSource {
     }
 
     fn bake(&self) {
-        self.baked.get_or_init(|| self.kind.bake(self.seed));
+        self.baked.get_or_init(|| shared_bake(self.kind, self.seed));
     }
+}
+
+/// The baked noise of `kind` and `seed`, shared by every field that holds it at once: a field
+/// built while another holds the same noise (a live edit, a batch of renders) bakes nothing.
+/// The cache keeps weak references, so the texels go with the last field that holds them.
+fn shared_bake(kind: NoiseKind, seed: u32) -> Arc<Texture8> {
+    type Cache = Vec<((NoiseKind, u32), Weak<Texture8>)>;
+    static CACHE: Mutex<Cache> = Mutex::new(Vec::new());
+    let lock = || {
+        CACHE
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    };
+    let held = lock()
+        .iter()
+        .find(|(key, _)| *key == (kind, seed))
+        .and_then(|(_, texels)| texels.upgrade());
+    if let Some(texels) = held {
+        return texels;
+    }
+    // Baked without the lock, so the three kinds bake in parallel.
+    let texels = Arc::new(kind.bake(seed));
+    let mut cache = lock();
+    cache.retain(|(key, held)| held.strong_count() > 0 && *key != (kind, seed));
+    cache.push(((kind, seed), Arc::downgrade(&texels)));
+    texels
 }
 
 /// Every cloud of a scene, as extinction over space and time.
@@ -183,7 +210,12 @@ impl CloudField {
             .iter()
             .enumerate()
             .map(|(i, v)| {
-                let mut grid = VoxelGrid::read_vol(&resolve(&v.path))
+                let policy = if v.sanitize {
+                    voxel::ValuePolicy::Replace
+                } else {
+                    voxel::ValuePolicy::Reject
+                };
+                let mut grid = VoxelGrid::read_vol_with(&resolve(&v.path), policy)
                     .map_err(|e| err(&format!("volumes.{i}.path"), e.to_string()))?;
                 grid.values
                     .iter_mut()
@@ -347,5 +379,21 @@ impl CloudField {
             .sample((q + Vec3::new(swirl.x, 0.0, swirl.y)) / self.noise.detail_period_m);
         let density = layer::erode(covered, detail, f, self.noise.detail_erosion);
         density * w.z * layer.extinction_per_m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn noise_baked_while_held_is_shared_and_freed_with_its_last_holder() {
+        let first = shared_bake(NoiseKind::Curl, 11);
+        let second = shared_bake(NoiseKind::Curl, 11);
+        assert!(Arc::ptr_eq(&first, &second));
+        assert!(!Arc::ptr_eq(&first, &shared_bake(NoiseKind::Curl, 12)));
+        let weak = Arc::downgrade(&first);
+        drop((first, second));
+        assert!(weak.upgrade().is_none());
     }
 }

@@ -53,25 +53,55 @@ impl Weather {
     }
 }
 
-/// Reads a PNG weather map (cargo feature `png`).
-#[cfg(feature = "png")]
+/// Most texels along either side of a weather map file: WebGPU's guaranteed
+/// `maxTextureDimension2D`, the size of the texture the map is uploaded to.
+pub const MAX_WEATHER_TEXELS: u32 = 8192;
+/// Most bytes the PNG decoder may allocate for one weather map: 512 MiB.
+pub const MAX_WEATHER_DECODE_BYTES: u64 = 512 << 20;
+
+/// Reads a PNG weather map file (cargo feature `png`).
 fn read_png(path: &Path) -> Result<Texture8, String> {
-    let img = image::open(path)
+    let bytes = std::fs::read(path)
         .map_err(|e| format!("cannot read weather map {}: {e}", path.display()))?;
-    let rgba = img.to_rgba8();
-    let dims = UVec3::new(rgba.width(), rgba.height(), 1);
-    let texels = rgba.pixels().map(|p| p.0).collect();
-    Ok(Texture8 { dims, texels })
+    Weather::texture_from_png(&bytes, path)
 }
 
-/// Without the `png` feature a weather map file is an error that names the feature.
-#[cfg(not(feature = "png"))]
-fn read_png(path: &Path) -> Result<Texture8, String> {
-    Err(format!(
-        "cannot read weather map {}: this build of cloudscape reads no PNG files; enable the `png` \
-         cargo feature of cloudscape, or use weather.source = \"procedural\"",
-        path.display()
-    ))
+impl Weather {
+    /// Decodes the bytes of a PNG weather map (named `path` in errors) into 8-bit RGBA texels,
+    /// refusing images above [`MAX_WEATHER_TEXELS`] a side or [`MAX_WEATHER_DECODE_BYTES`] of
+    /// decoding before they are decoded. PNG samples are unsigned integers, so every texel is a
+    /// finite value in 0..1. Needs the cargo feature `png`.
+    #[cfg(feature = "png")]
+    pub fn texture_from_png(bytes: &[u8], path: &Path) -> Result<Texture8, String> {
+        let mut limits = image::Limits::default();
+        limits.max_image_width = Some(MAX_WEATHER_TEXELS);
+        limits.max_image_height = Some(MAX_WEATHER_TEXELS);
+        limits.max_alloc = Some(MAX_WEATHER_DECODE_BYTES);
+        let mut reader =
+            image::ImageReader::with_format(std::io::Cursor::new(bytes), image::ImageFormat::Png);
+        reader.limits(limits);
+        let img = reader.decode().map_err(|e| {
+            format!(
+                "cannot read weather map {}: {e} (a PNG of at most {MAX_WEATHER_TEXELS}x\
+                 {MAX_WEATHER_TEXELS} texels is allowed)",
+                path.display()
+            )
+        })?;
+        let rgba = img.into_rgba8();
+        let dims = UVec3::new(rgba.width(), rgba.height(), 1);
+        let texels = rgba.pixels().map(|p| p.0).collect();
+        Ok(Texture8 { dims, texels })
+    }
+
+    /// Without the `png` feature a weather map is an error that names the feature.
+    #[cfg(not(feature = "png"))]
+    pub fn texture_from_png(_bytes: &[u8], path: &Path) -> Result<Texture8, String> {
+        Err(format!(
+            "cannot read weather map {}: this build of cloudscape reads no PNG files; enable the \
+             `png` cargo feature of cloudscape, or use weather.source = \"procedural\"",
+            path.display()
+        ))
+    }
 }
 
 /// A procedural map: coverage and type are periodic Perlin fBm with `cells` features across the
@@ -162,6 +192,30 @@ mod tests {
             })
             .sum();
         assert!(edge_diff < 0.5 * far_diff, "{edge_diff} vs {far_diff}");
+    }
+
+    #[test]
+    fn an_oversized_or_broken_png_is_refused_with_its_path() {
+        let too_wide = crate::image::LdrImage {
+            width: MAX_WEATHER_TEXELS + 1,
+            height: 1,
+            pixels: vec![[0; 4]; MAX_WEATHER_TEXELS as usize + 1],
+        };
+        let dir = crate::fsutil::ScratchDir::new("weather-too-wide");
+        let path = dir.join("wide.png");
+        too_wide.write_png(&path).unwrap();
+        let map = WeatherMap {
+            source: WeatherSource::File,
+            ..WeatherMap::default()
+        };
+        let err = Weather::from_scene(&map, Some(&path)).unwrap_err();
+        assert!(
+            err.contains("wide.png") && err.contains("8192x8192"),
+            "{err}"
+        );
+        let bytes = std::fs::read(&path).unwrap();
+        let err = Weather::texture_from_png(&bytes[..60], &path).unwrap_err();
+        assert!(err.starts_with("cannot read weather map"), "{err}");
     }
 
     #[test]

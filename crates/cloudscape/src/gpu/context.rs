@@ -1,8 +1,9 @@
 //! Adapter and device set-up: the only code in the crate that knows wgpu's set-up API.
 //!
-//! [`GpuContext::new`] enumerates every adapter of the allowed backends, filters them by name, ranks
-//! them (discrete > integrated > virtual > CPU > other, then Vulkan / Metal / DX12 over GL) and opens
-//! a device with the adapter's own limits and, when available, timestamp queries.
+//! [`GpuContext::new`] enumerates every adapter of the allowed backends (without a backend asked
+//! for, Vulkan, Metal and DX12, and GL only when none of them has an adapter), filters them by
+//! name, ranks them (discrete > integrated > virtual > CPU > other, then Vulkan / Metal / DX12 over
+//! GL) and opens a device with the adapter's own limits and, when available, timestamp queries.
 
 use std::fmt;
 use std::str::FromStr;
@@ -118,6 +119,8 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
     adapter: wgpu::Adapter,
     info: wgpu::AdapterInfo,
+    /// The instance the adapter came from, when this context made it (not a host's device).
+    instance: Option<wgpu::Instance>,
 }
 
 impl GpuContext {
@@ -128,13 +131,15 @@ impl GpuContext {
     }
 
     async fn new_async(options: &GpuOptions) -> Result<GpuContext, GpuError> {
-        let backends = options.backend.map_or(all_backends(), Backend::to_wgpu);
-        let mut instance_descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
-        instance_descriptor.backends = backends;
-        instance_descriptor.flags = instance_descriptor.flags.with_env();
-        let instance = wgpu::Instance::new(instance_descriptor);
-        let adapters = instance.enumerate_adapters(backends).await;
-        let adapter = choose_adapter(adapters, options)?;
+        let (instance, adapter) = match options.backend {
+            Some(backend) => find_adapter(backend.to_wgpu(), options).await?,
+            // GL is probed only when no native API offers an adapter: its probe of the display
+            // servers is slow and, without XDG_RUNTIME_DIR, prints a frightening libwayland error.
+            None => match find_adapter(native_backends(), options).await {
+                Ok(found) => found,
+                Err(_) => find_adapter(all_backends(), options).await?,
+            },
+        };
         let info = adapter.get_info();
         let (device, queue) = adapter
             .request_device(&device_descriptor(&adapter))
@@ -148,6 +153,7 @@ impl GpuContext {
             queue,
             adapter,
             info,
+            instance: Some(instance),
         })
     }
 
@@ -166,6 +172,7 @@ impl GpuContext {
             queue,
             adapter,
             info,
+            instance: None,
         }
     }
 
@@ -196,6 +203,11 @@ impl GpuContext {
         self.adapter.features()
     }
 
+    /// The GPU memory and live objects wgpu reports now (see [`super::GpuMemoryReport`]).
+    pub fn memory_report(&self) -> super::GpuMemoryReport {
+        super::GpuMemoryReport::new(&self.device, self.instance.as_ref())
+    }
+
     /// Blocks until the GPU has finished all submitted work.
     ///
     /// # Panics
@@ -224,6 +236,25 @@ impl GpuContext {
             })
             .clone()
     }
+}
+
+/// An instance of `backends` and the adapter [`choose_adapter`] picks among its adapters.
+async fn find_adapter(
+    backends: wgpu::Backends,
+    options: &GpuOptions,
+) -> Result<(wgpu::Instance, wgpu::Adapter), GpuError> {
+    let mut instance_descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
+    instance_descriptor.backends = backends;
+    instance_descriptor.flags = instance_descriptor.flags.with_env();
+    let instance = wgpu::Instance::new(instance_descriptor);
+    let adapters = instance.enumerate_adapters(backends).await;
+    let adapter = choose_adapter(adapters, options)?;
+    Ok((instance, adapter))
+}
+
+/// Every backend but GL.
+fn native_backends() -> wgpu::Backends {
+    all_backends() - Backend::Gl.to_wgpu()
 }
 
 fn all_backends() -> wgpu::Backends {

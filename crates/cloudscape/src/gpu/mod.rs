@@ -3,13 +3,16 @@
 //! - [`context`]: adapter choice and device creation, the only place that knows wgpu's set-up API.
 //! - [`readback`]: copying textures and buffers back to the CPU.
 //! - [`timing`]: per-pass GPU time from timestamp queries.
+//! - [`memory`]: the memory and live objects wgpu reports, for leak checks.
 //! - [`pipeline`]: compute and raster pipeline builders; [`uniform`]: a uniform in its own group.
 
 pub mod context;
+pub mod memory;
 pub mod readback;
 pub mod timing;
 
 pub use context::{Backend, GpuContext, GpuError, GpuOptions};
+pub use memory::GpuMemoryReport;
 pub use readback::{read_buffer, read_texture, read_texture_rgba16f, read_texture_rgba32f};
 pub use timing::PassTimer;
 pub mod late_readback;

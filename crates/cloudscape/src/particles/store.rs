@@ -9,7 +9,7 @@ use super::ParticleTableSpec;
 use super::density::ReferenceParticle;
 use super::optical_depth::{ChordProfile, OpticalDepthLayout, OpticalDepthTable};
 use super::scattering::{BakeReport, Progress, ScatteringLayout, ScatteringTables};
-use super::table_file::{TableError, TableFile, TableKind, TableProblem};
+use super::table_file::{TableError, TableFile, TableKind, TableProblem, read_bytes};
 
 /// The scattering tables of the default scene (`cloudscape bake` of it writes this file).
 pub const SHIPPED_SCATTERING: &[u8] = include_bytes!("tables/default-scattering.cslut");
@@ -66,12 +66,18 @@ impl TableStore {
         progress: Progress,
     ) -> std::io::Result<(ScatteringTables, TableOrigin)> {
         let key = spec.scattering_key();
-        if let Ok(file) = TableFile::decode(SHIPPED_SCATTERING, TableKind::Scattering, key) {
-            return Ok((scattering_from_file(&file), TableOrigin::Shipped));
+        if let Ok(tables) = scattering_from_bytes(SHIPPED_SCATTERING, spec) {
+            return Ok((tables, TableOrigin::Shipped));
         }
         let path = self.scattering_path(key);
-        let replaced = match TableFile::read(&path, TableKind::Scattering, key) {
-            Ok(file) => return Ok((scattering_from_file(&file), TableOrigin::Cached(path))),
+        let read = read_bytes(&path).and_then(|bytes| {
+            scattering_from_bytes(&bytes, spec).map_err(|problem| TableError {
+                path: path.clone(),
+                problem,
+            })
+        });
+        let replaced = match read {
+            Ok(tables) => return Ok((tables, TableOrigin::Cached(path))),
             Err(TableError {
                 problem: TableProblem::Unreadable(_),
                 ..
@@ -168,6 +174,35 @@ pub fn read_optical_depth(
     path: &Path,
     spec: &ParticleTableSpec,
 ) -> Result<OpticalDepthTable, TableError> {
-    TableFile::read(path, TableKind::OpticalDepth, spec.optical_depth_key())
-        .map(|f| optical_depth_from_file(&f, &spec.particle))
+    read_bytes(path).and_then(|bytes| {
+        optical_depth_from_bytes(&bytes, spec).map_err(|problem| TableError {
+            path: path.to_path_buf(),
+            problem,
+        })
+    })
+}
+
+/// The scattering tables of `spec` in the bytes of a table file: of its kind, key and shape,
+/// whole, and holding only finite values >= 0.
+pub fn scattering_from_bytes(
+    bytes: &[u8],
+    spec: &ParticleTableSpec,
+) -> Result<ScatteringTables, TableProblem> {
+    let d = spec.scattering.texture_dims();
+    TableFile::decode(bytes, TableKind::Scattering, spec.scattering_key())
+        .and_then(|file| file.expect_shape([d.x, d.y, d.z, 1], 2))
+        .map(|file| scattering_from_file(&file))
+}
+
+/// The optical-depth table of `spec` in the bytes of a table file, checked as
+/// [`scattering_from_bytes`] checks.
+pub fn optical_depth_from_bytes(
+    bytes: &[u8],
+    spec: &ParticleTableSpec,
+) -> Result<OpticalDepthTable, TableProblem> {
+    let l = spec.optical_depth;
+    let dims = [l.start_zenith, l.start_azimuth, l.dir_zenith, l.dir_azimuth];
+    TableFile::decode(bytes, TableKind::OpticalDepth, spec.optical_depth_key())
+        .and_then(|file| file.expect_shape(dims, 1))
+        .map(|file| optical_depth_from_file(&file, &spec.particle))
 }

@@ -79,6 +79,27 @@ pub enum TableProblem {
     WrongKind,
     /// Its contents do not match its checksum.
     Corrupt,
+    /// Its header claims more values than an address space holds.
+    TooLarge {
+        /// The dimensions it claims.
+        dims: [u32; 4],
+        /// The channels it claims.
+        channels: u32,
+    },
+    /// It holds a value that is not finite and >= 0 (every table holds ratios or radiances).
+    BadValue {
+        /// Index of the value, channels interleaved.
+        index: usize,
+        /// The value.
+        value: f32,
+    },
+    /// Its dimensions or channels are not those its key implies.
+    WrongShape {
+        /// Dimensions and channels found.
+        found: ([u32; 4], u32),
+        /// Dimensions and channels expected.
+        expected: ([u32; 4], u32),
+    },
     /// It was baked for other inputs.
     Stale {
         /// The key it has.
@@ -100,6 +121,21 @@ impl fmt::Display for TableProblem {
             }
             TableProblem::WrongKind => write!(f, "holds another kind of table"),
             TableProblem::Corrupt => write!(f, "is corrupt: its checksum does not match"),
+            TableProblem::TooLarge { dims, channels } => {
+                write!(
+                    f,
+                    "claims {dims:?} entries of {channels} values: too many to hold"
+                )
+            }
+            TableProblem::BadValue { index, value } => write!(
+                f,
+                "holds {value} at index {index}; table values must be finite and >= 0"
+            ),
+            TableProblem::WrongShape { found, expected } => write!(
+                f,
+                "has {:?} entries of {} values; its key needs {:?} of {}",
+                found.0, found.1, expected.0, expected.1
+            ),
             TableProblem::Stale { found, expected } => write!(
                 f,
                 "is stale: baked for inputs {found:016x}, the scene needs {expected:016x}"
@@ -133,7 +169,7 @@ impl TableFile {
         for v in &self.values {
             bytes.extend_from_slice(&v.to_bits().to_le_bytes());
         }
-        let checksum = fnv1a(&bytes);
+        let checksum = checksum(&bytes);
         bytes.extend_from_slice(&checksum.to_le_bytes());
         bytes
     }
@@ -160,12 +196,12 @@ impl TableFile {
             u32_at(bytes, 36),
         ];
         let channels = u32_at(bytes, 40);
-        let count = dims
+        let expected = dims
             .iter()
             .chain([&channels])
-            .map(|&d| d as usize)
-            .product::<usize>();
-        let expected = HEADER_BYTES + count * 2 + 8;
+            .try_fold(2usize, |n, &d| n.checked_mul(d as usize))
+            .and_then(|n| n.checked_add(HEADER_BYTES + 8))
+            .ok_or(TableProblem::TooLarge { dims, channels })?;
         if bytes.len() != expected {
             return Err(TableProblem::Truncated {
                 found: bytes.len(),
@@ -174,7 +210,7 @@ impl TableFile {
         }
         let body = &bytes[..expected - 8];
         let stored = u64::from_le_bytes(bytes[expected - 8..].try_into().expect("8 bytes"));
-        if fnv1a(body) != stored {
+        if checksum(body) != stored {
             return Err(TableProblem::Corrupt);
         }
         if u32_at(bytes, 12) != kind.code() {
@@ -187,10 +223,17 @@ impl TableFile {
                 expected: key,
             });
         }
-        let values = body[HEADER_BYTES..]
+        let values: Vec<f16> = body[HEADER_BYTES..]
             .chunks_exact(2)
             .map(|c| f16::from_bits(u16::from_le_bytes([c[0], c[1]])))
             .collect();
+        if let Some(index) = values
+            .iter()
+            .position(|v| !(v.is_finite() && v.to_f32() >= 0.0))
+        {
+            let value = values[index].to_f32();
+            return Err(TableProblem::BadValue { index, value });
+        }
         Ok(TableFile {
             kind,
             key,
@@ -200,15 +243,25 @@ impl TableFile {
         })
     }
 
+    /// The table when its dimensions and channels are `dims` and `channels` (those its key
+    /// implies); a file of another shape, though its checksum and key match, is never used.
+    pub fn expect_shape(self, dims: [u32; 4], channels: u32) -> Result<TableFile, TableProblem> {
+        if (self.dims, self.channels) != (dims, channels) {
+            return Err(TableProblem::WrongShape {
+                found: (self.dims, self.channels),
+                expected: (dims, channels),
+            });
+        }
+        Ok(self)
+    }
+
     /// Reads the table of `kind` with `key` at `path`.
     pub fn read(path: &Path, kind: TableKind, key: u64) -> Result<TableFile, TableError> {
-        let error = |problem| TableError {
+        let bytes = read_bytes(path)?;
+        Self::decode(&bytes, kind, key).map_err(|problem| TableError {
             path: path.to_path_buf(),
             problem,
-        };
-        let bytes =
-            std::fs::read(path).map_err(|e| error(TableProblem::Unreadable(e.to_string())))?;
-        Self::decode(&bytes, kind, key).map_err(error)
+        })
     }
 
     /// Writes the file atomically (a reader never sees half of it), making its directory.
@@ -220,8 +273,21 @@ impl TableFile {
     }
 }
 
+/// The bytes of the file at `path`, or why they cannot be read.
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, TableError> {
+    std::fs::read(path).map_err(|e| TableError {
+        path: path.to_path_buf(),
+        problem: TableProblem::Unreadable(e.to_string()),
+    })
+}
+
 fn u32_at(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"))
+}
+
+/// The checksum a table file ends with, of `body`, every byte before it: 64-bit FNV-1a.
+pub fn checksum(body: &[u8]) -> u64 {
+    fnv1a(body)
 }
 
 /// Builds a table key from its inputs, each written in a fixed byte order.
@@ -315,6 +381,45 @@ mod tests {
             decode(b"P6 640 480 255 and more bytes than a header"),
             TableProblem::NotATable
         );
+    }
+
+    /// `bytes` with the checksum made right again after an edit.
+    fn resealed(mut bytes: Vec<u8>) -> Vec<u8> {
+        let body = bytes.len() - 8;
+        let sum = checksum(&bytes[..body]);
+        bytes[body..].copy_from_slice(&sum.to_le_bytes());
+        bytes
+    }
+
+    #[test]
+    fn a_bad_value_a_wrong_shape_and_a_huge_header_are_refused() {
+        let mut bytes = table().encode();
+        bytes[HEADER_BYTES + 6..HEADER_BYTES + 8]
+            .copy_from_slice(&f16::NAN.to_bits().to_le_bytes());
+        let decode = |b: &[u8]| TableFile::decode(b, TableKind::Scattering, 42);
+        assert!(matches!(
+            decode(&resealed(bytes.clone())),
+            Err(TableProblem::BadValue { index: 3, value }) if value.is_nan()
+        ));
+        let negative = f16::from_f32(-1.0).to_bits().to_le_bytes();
+        bytes[HEADER_BYTES + 6..HEADER_BYTES + 8].copy_from_slice(&negative);
+        assert_eq!(
+            decode(&resealed(bytes)),
+            Err(TableProblem::BadValue {
+                index: 3,
+                value: -1.0
+            })
+        );
+        let shape = table().expect_shape([3, 2, 2, 1], 1).unwrap_err();
+        assert!(
+            shape
+                .to_string()
+                .contains("its key needs [3, 2, 2, 1] of 1"),
+            "{shape}"
+        );
+        let mut huge = table().encode();
+        huge[24..44].copy_from_slice(&[u32::MAX; 5].map(u32::to_le_bytes).concat());
+        assert!(matches!(decode(&huge), Err(TableProblem::TooLarge { .. })));
     }
 
     #[test]

@@ -431,6 +431,9 @@ pub struct VolumeGrid {
     pub size_m: [f32; 3],
     /// Extinction in m^-1 where the grid value is 1, 0..10.
     pub extinction_per_m: f32,
+    /// Replace the file's values that are not densities (NaN and negative by 0, above 65504 by
+    /// 65504) instead of refusing the file; off by default.
+    pub sanitize: bool,
 }
 
 impl Default for VolumeGrid {
@@ -440,6 +443,7 @@ impl Default for VolumeGrid {
             center_m: [0.0, 2500.0, -6000.0],
             size_m: [2000.0, 2000.0, 2000.0],
             extinction_per_m: 0.05,
+            sanitize: false,
         }
     }
 }
