@@ -6,6 +6,7 @@ mod bench;
 mod common;
 mod compare;
 mod export;
+mod fit_lighting;
 mod interrupt;
 mod reference;
 mod render;
@@ -38,6 +39,9 @@ enum Command {
     /// Render the canonical scenes with the ray marcher and the path tracer, compare them, and
     /// write `docs/realism.md`.
     Report(report::ReportArgs),
+    /// Fit the ray marcher's multiple-scattering octaves to the path tracer on generated scenes
+    /// (none of them canonical) and score the fit on held-out ones.
+    FitLighting(fit_lighting::FitLightingArgs),
     /// Render a scene's frames over scene time (camera, sun and coverage paths, wind) to PNG or
     /// EXR files, with an animated GIF preview (and an MP4 when ffmpeg is on PATH).
     Animate(animate::AnimateArgs),
@@ -60,6 +64,7 @@ fn main() -> std::process::ExitCode {
         Command::Reference(args) => reference::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Report(args) => report::run(args),
+        Command::FitLighting(args) => fit_lighting::run(args),
         Command::Animate(args) => animate::run(args),
         Command::Bake(args) => bake::run(args),
     };

@@ -133,6 +133,14 @@ pub fn constants_wgsl() -> String {
     put(format!(
         "const MAX_HIHEIGHT_LEVELS: u32 = {MAX_HIHEIGHT_LEVELS}u;"
     ));
+    put(format!(
+        "const MARCH_SUN_PATH_MIN_M: f32 = {:?};",
+        crate::raymarch::SUN_PATH_M.0
+    ));
+    put(format!(
+        "const MARCH_SUN_PATH_MAX_M: f32 = {:?};",
+        crate::raymarch::SUN_PATH_M.1
+    ));
     atmosphere_constants(&mut put);
     let gradients: Vec<String> = profile::TYPE_GRADIENTS
         .iter()

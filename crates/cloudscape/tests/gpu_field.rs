@@ -41,6 +41,7 @@ fn compare(scene: &Scene, base_dir: &std::path::Path, points: &[Vec3], time_s: f
         .map(|p| ProbeInput {
             a: p.extend(1.0),
             b: Vec4::ZERO,
+            c: Vec4::ZERO,
         })
         .collect();
     let probe = Probe::new(&ctx, &clouds.shared());

@@ -6,7 +6,7 @@
 use cloudscape::environment::{Environment, ViewedEnvironment};
 use cloudscape::frame::{DepthConvention, Frame};
 use cloudscape::gpu::GpuContext;
-use cloudscape::optics::{PhaseLobes, diffuse_transmittance, two_stream_share_from_below};
+use cloudscape::optics::{Octaves, PhaseLobes, diffuse_transmittance, two_stream_share_from_below};
 use cloudscape::post::tonemap;
 use cloudscape::probe::{Probe, ProbeFunction, ProbeInput};
 use cloudscape::renderer::{CloudRenderer, Reuse};
@@ -39,7 +39,11 @@ fn gpu(
 }
 
 fn input(a: Vec4, b: Vec4) -> ProbeInput {
-    ProbeInput { a, b }
+    ProbeInput {
+        a,
+        b,
+        c: Vec4::ZERO,
+    }
 }
 
 /// A deterministic value in [0, 1) for index `i` and stream `k`.
@@ -537,6 +541,30 @@ fn phase_functions_and_height_profiles_match_the_cpu() {
             .map(|(mu, factor)| Vec4::splat(phase.scaled_anisotropy(*factor).eval(*mu)))
             .collect();
         assert_close(&format!("{phase:?}"), &got, &want, 1e-4);
+        let octaves = Octaves {
+            count: 6,
+            attenuation: 0.3,
+            contribution: 0.6,
+            eccentricity: 0.5,
+        };
+        let inputs: Vec<ProbeInput> = (0..200)
+            .map(|i| ProbeInput {
+                a: Vec4::from_array(phase.to_gpu()),
+                b: Vec4::from_array([
+                    octaves.factors()[0],
+                    octaves.factors()[1],
+                    octaves.factors()[2],
+                    0.0,
+                ]),
+                c: Vec4::new(2.0 * unit(i, 25) - 1.0, 60.0 * unit(i, 26), 6.0, 0.0),
+            })
+            .collect();
+        let got = gpu(&ctx, &clouds, ProbeFunction::Octaves, &inputs);
+        let want: Vec<Vec4> = inputs
+            .iter()
+            .map(|p| Vec4::splat(octaves.scattering(&phase, p.c.x, p.c.y)))
+            .collect();
+        assert_close(&format!("octaves of {phase:?}"), &got, &want, 1e-4);
     }
     let cases: Vec<ProbeInput> = (0..300)
         .map(|i| {

@@ -6,7 +6,7 @@
 pub mod phase;
 pub mod step;
 
-pub use phase::{PhaseLobes, draine, henyey_greenstein};
+pub use phase::{Octaves, PhaseLobes, draine, henyey_greenstein};
 pub use step::MarchState;
 
 /// Eddington (two-stream) diffuse transmittance of a conservatively scattering slab of optical

@@ -152,6 +152,43 @@ impl PhaseLobes {
     }
 }
 
+/// Wrenninge's multiple-scattering octaves (Wrenninge 2013, "Oz: The Great and Volumetric"): light
+/// scattered `i` more times is approximated by a copy of single scattering whose optical depth,
+/// weight and phase asymmetry are scaled by `a^i`, `b^i` and `c^i`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Octaves {
+    /// Octaves summed, 1 (single scattering) or more.
+    pub count: u32,
+    /// Extinction factor `a`: octave `i` sees `a^i` of the optical depth to the sun.
+    pub attenuation: f32,
+    /// Scattering factor `b`: octave `i` scatters `b^i` of the light.
+    pub contribution: f32,
+    /// Eccentricity factor `c`: octave `i`'s asymmetries are scaled by `c^i`.
+    pub eccentricity: f32,
+}
+
+impl Octaves {
+    /// Sun light scattered at optical depth `tau` from the sun per unit scattering coefficient
+    /// and unit irradiance, for the scattering cosine `cos_theta`:
+    /// `sum_i b^i p(c^i g, cos_theta) exp(-a^i tau)`. `phase_octaves` in `phase.wgsl`.
+    pub fn scattering(&self, lobes: &PhaseLobes, cos_theta: f32, tau: f32) -> f32 {
+        let (mut sum, mut weight, mut extinction, mut anisotropy) = (0.0, 1.0, 1.0, 1.0);
+        for _ in 0..self.count {
+            let p = lobes.scaled_anisotropy(anisotropy).eval(cos_theta);
+            sum += weight * p * (-extinction * tau).exp();
+            weight *= self.contribution;
+            extinction *= self.attenuation;
+            anisotropy *= self.eccentricity;
+        }
+        sum
+    }
+
+    /// The factors `(a, b, c)` as `phase_octaves` takes them.
+    pub fn factors(&self) -> [f32; 3] {
+        [self.attenuation, self.contribution, self.eccentricity]
+    }
+}
+
 /// Henyey-Greenstein phase function per steradian (Henyey & Greenstein 1941):
 /// `(1 - g^2) / (4 pi (1 + g^2 - 2 g mu)^(3/2))`, `g` in (-1, 1).
 pub fn henyey_greenstein(g: f32, cos_theta: f32) -> f32 {

@@ -35,3 +35,20 @@ fn phase_eval(lobes: vec4<f32>, cos_theta: f32) -> f32 {
 fn phase_scaled(lobes: vec4<f32>, factor: f32) -> vec4<f32> {
     return vec4<f32>(lobes.xy * factor, lobes.zw);
 }
+
+// Sun light scattered at optical depth tau from the sun, per unit sigma_s and unit irradiance,
+// with `count` multiple-scattering octaves (Wrenninge 2013, "Oz: The Great and Volumetric"):
+// sum_i b^i p(c^i g, mu) exp(-a^i tau), factors = (a, b, c). Octaves::scattering.
+fn phase_octaves(lobes: vec4<f32>, factors: vec3<f32>, count: u32, cos_theta: f32, tau: f32) -> f32 {
+    var sum = 0.0;
+    var weight = 1.0;
+    var extinction = 1.0;
+    var anisotropy = 1.0;
+    for (var i = 0u; i < count; i++) {
+        sum += weight * phase_eval(phase_scaled(lobes, anisotropy), cos_theta) * exp(-extinction * tau);
+        weight *= factors.y;
+        extinction *= factors.x;
+        anisotropy *= factors.z;
+    }
+    return sum;
+}

@@ -59,6 +59,9 @@ pub enum ProbeFunction {
     CloudSkyOpticalDepth = 19,
     /// `frame_two_stream_share_from_below(a.x, a.y)`: `optics::two_stream_share_from_below`.
     TwoStreamShareFromBelow = 20,
+    /// `phase_octaves(lobes a, factors b.xyz, count c.z, cos theta c.x, tau c.y)`:
+    /// `Octaves::scattering`.
+    Octaves = 21,
 }
 
 /// The inputs of one evaluation.
@@ -69,6 +72,8 @@ pub struct ProbeInput {
     pub a: Vec4,
     /// Second argument vector.
     pub b: Vec4,
+    /// Third argument vector.
+    pub c: Vec4,
 }
 
 /// The probe pipeline, built against the shared groups.

@@ -5,6 +5,7 @@
 struct ProbeInput {
     a: vec4<f32>,
     b: vec4<f32>,
+    c: vec4<f32>,
 }
 
 struct Probe {
@@ -15,7 +16,7 @@ struct Probe {
 @group(3) @binding(1) var<storage, read> probe_inputs: array<ProbeInput>;
 @group(3) @binding(2) var<storage, read_write> probe_outputs: array<vec4<f32>>;
 
-fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
+fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
     switch f {
         case 0u: { return vec4<f32>(field_extinction(a.xyz)); }
         case 1u: { return vec4<f32>(field_extinction_coarse(a.xyz)); }
@@ -38,6 +39,7 @@ fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
         case 18u: { return vec4<f32>(environment_cloud_sun_optical_depth(a.xyz)); }
         case 19u: { return vec4<f32>(environment_cloud_sky_optical_depth(a.xyz)); }
         case 20u: { return vec4<f32>(frame_two_stream_share_from_below(a.x, a.y)); }
+        case 21u: { return vec4<f32>(phase_octaves(a, b.xyz, u32(c.z), c.x, c.y)); }
         default: { return vec4<f32>(-1.0); }
     }
 }
@@ -48,5 +50,5 @@ fn probe_functions(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let input = probe_inputs[id.x];
-    probe_outputs[id.x] = probe_eval(probe.function, input.a, input.b);
+    probe_outputs[id.x] = probe_eval(probe.function, input.a, input.b, input.c);
 }

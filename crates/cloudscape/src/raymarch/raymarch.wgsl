@@ -47,19 +47,15 @@ struct MarchSum {
 
 // Rays stop once this little light gets through (VolumeCloud's threshold, peers.md).
 const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
-// Longest path toward the sun (m): past 4 km of cumulus (optical depth ~ 200 at 0.05 m^-1) a shadow
-// is complete, and longer single-sample segments only add noise.
-const MARCH_SUN_PATH_MAX_M: f32 = 4000.0;
-
 // Optical depth toward the sun from p, through the coarse (uneroded) density as Schneider 2015's
 // cheap light samples: `light_steps` segments whose lengths double, covering the way to the top of
-// the layers (at most MARCH_SUN_PATH_MAX_M) (VolumeCloud samples the sun path at 0.5, 1.5, 3, 6, 12
+// the layers (MARCH_SUN_PATH_MIN_M..MARCH_SUN_PATH_MAX_M, raymarch::SUN_PATH_M) (VolumeCloud samples the sun path at 0.5, 1.5, 3, 6, 12
 // units with weights 1, 1, 2, 4, 8; peers.md).
 fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
     let sun = environment_sun_direction();
     var length_m = MARCH_SUN_PATH_MAX_M;
     if field.layer_count > 0u {
-        length_m = clamp(field_below(p, sun, field.layer_top_m).y, 50.0, MARCH_SUN_PATH_MAX_M);
+        length_m = clamp(field_below(p, sun, field.layer_top_m).y, MARCH_SUN_PATH_MIN_M, MARCH_SUN_PATH_MAX_M);
     }
     return field_optical_depth_coarse(p, sun, vec3<f32>(0.0, length_m, 2.0), march.light_steps, jitter);
 }
@@ -100,22 +96,6 @@ fn march_light(p: vec3<f32>) -> MarchLight {
         below = environment_sky_radiance(-field_up(p));
     }
     return MarchLight(environment_sun_irradiance(p), environment_sky_mean_radiance_up(p), below);
-}
-
-// Sun light scattered toward the eye per unit sigma_s and unit sun irradiance, with
-// multiple-scattering octaves (Wrenninge 2013): sum_i b^i p(c^i g, mu) exp(-a^i tau_sun).
-fn march_sun_scattering(cos_theta: f32, tau_sun: f32) -> f32 {
-    var sum = 0.0;
-    var weight = 1.0;
-    var extinction = 1.0;
-    var anisotropy = 1.0;
-    for (var i = 0u; i < march.octaves; i++) {
-        sum += weight * phase_eval(phase_scaled(march.phase_lobes, anisotropy), cos_theta) * exp(-extinction * tau_sun);
-        weight *= march.octave_contribution;
-        extinction *= march.octave_attenuation;
-        anisotropy *= march.octave_eccentricity;
-    }
-    return sum;
 }
 
 // Ray parameter of stratum boundary u in [0, 1]: quadratic spacing, so strata start short where
@@ -184,7 +164,8 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
         }
         let h = field_altitude_m(p);
         let tau_sun = march_sun_optical_depth(p, jitter);
-        let sun = march_sun_scattering(cos_theta, tau_sun) * light.sun;
+        let factors = vec3<f32>(march.octave_attenuation, march.octave_contribution, march.octave_eccentricity);
+        let sun = phase_octaves(march.phase_lobes, factors, march.octaves, cos_theta, tau_sun) * light.sun;
         let source = albedo * (sun + march_ambient(p, h, light));
         let step_transmittance = exp(-sigma_t * dt);
         radiance += transmittance * source * (1.0 - step_transmittance);

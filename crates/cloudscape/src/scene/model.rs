@@ -514,6 +514,18 @@ pub struct Lighting {
     pub ambient_scale: f32,
 }
 
+impl Lighting {
+    /// The multiple-scattering octaves these settings describe.
+    pub fn octaves(&self) -> crate::optics::Octaves {
+        crate::optics::Octaves {
+            count: self.octaves,
+            attenuation: self.octave_attenuation,
+            contribution: self.octave_contribution,
+            eccentricity: self.octave_eccentricity,
+        }
+    }
+}
+
 impl Default for Lighting {
     fn default() -> Self {
         Lighting {

@@ -1,0 +1,150 @@
+//! Training data for the ray marcher's lighting: points inside the clouds of generated scenes, with
+//! what the march knows there (its light samples toward the sun, the view and sun directions) and
+//! what the path tracer says the clouds scatter there under the sun alone.
+//!
+//! The scenes are drawn at random (cloud type, cover, extinction, thickness, base, sun) and none is a
+//! canonical scene of the realism report, so the report tests the fit on scenes it never saw. The
+//! points are where random camera rays first collide with the clouds (delta tracking), so they are
+//! spread over the clouds as the march's contributions are: by extinction times transmittance
+//! from the eye.
+
+use anyhow::{Result, anyhow};
+use cloudscape::raymarch::{MarchSettings, SUN_PATH_M};
+use cloudscape::scene::{Quality, SceneDocument};
+use cloudscape_reference::geometry::below_altitude;
+use cloudscape_reference::rng::Rng;
+use cloudscape_reference::sampling::uniform_sphere;
+use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer};
+use glam::{UVec2, Vec3};
+use rayon::prelude::*;
+
+/// Distance within which camera rays look for a cloud, metres.
+const RAY_REACH_M: f32 = 60_000.0;
+/// Side of the square the cameras stand in, metres.
+const CAMERA_SPREAD_M: f32 = 30_000.0;
+
+/// One point of the training data.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Training scene it comes from.
+    pub scene: u32,
+    /// Optical depth toward the sun from the march's light samples (High quality).
+    pub tau_sun: f32,
+    /// Cosine between the view ray's direction and the sun's.
+    pub cos_theta: f32,
+    /// Sine of the sun's elevation.
+    pub sun_y: f32,
+    /// Source radiance per unit extinction and unit sun irradiance: the path tracer's estimate.
+    pub source: f32,
+    /// Standard error of that estimate.
+    pub source_error: f32,
+}
+
+/// The generated training scene `index`: a cloud layer and a sun drawn from `index`, lit by the sun
+/// alone (no sky, no ground, no haze), so the light found at a point is the sun's.
+pub fn training_scene(index: u32) -> Result<SceneDocument> {
+    let mut rng = Rng::for_sample(0x5eed, u64::from(index), 0);
+    let mut draw = |lo: f32, hi: f32| lo + (hi - lo) * rng.next_f32();
+    let elevation = draw(3.0, 87.0);
+    let azimuth = draw(0.0, 360.0);
+    let coverage = draw(0.15, 0.95);
+    let extinction = draw(0.02, 0.09);
+    let bottom = draw(800.0, 2300.0);
+    let (types, thickness) = match (draw(0.0, 4.0)) as u32 {
+        0 => ("{ stratus = 1.0 }", draw(200.0, 800.0)),
+        1 => ("{ stratocumulus = 1.0 }", draw(500.0, 1500.0)),
+        2 => ("{ cumulus = 1.0 }", draw(1000.0, 3500.0)),
+        _ => (
+            "{ cumulonimbus = 0.6, cumulus = 0.4 }",
+            draw(5000.0, 10000.0),
+        ),
+    };
+    let overrides = [
+        format!("sun.elevation_deg={elevation}"),
+        format!("sun.azimuth_deg={azimuth}"),
+        "sun.irradiance=1.0".into(),
+        "sky.model=\"constant\"".into(),
+        "sky.radiance=[0.0, 0.0, 0.0]".into(),
+        "sky.visibility_m=10000000.0".into(),
+        "ground.enabled=false".into(),
+        format!("layers.0.coverage={coverage}"),
+        format!("layers.0.extinction_per_m={extinction}"),
+        format!("layers.0.thickness_m={thickness}"),
+        format!("layers.0.bottom_m={bottom}"),
+        format!("layers.0.types={types}"),
+        format!("layers.0.noise_seed={}", 100 + index),
+        format!("weather.seed={}", 200 + index),
+    ];
+    Ok(SceneDocument::load(None, &overrides)?)
+}
+
+/// `points` camera rays into training scene `index`, each collision estimated with `paths` paths.
+pub fn scene_samples(index: u32, points: u32, paths: u32) -> Result<Vec<Sample>> {
+    let doc = training_scene(index)?;
+    let tracer = PathTracer::for_scene(
+        &doc.scene,
+        &doc.resolve_path(""),
+        UVec2::ONE,
+        DEFAULT_MAJORANT_CELLS,
+    )
+    .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
+    let light_steps = MarchSettings::preset(Quality::High).1;
+    let samples = (0..points)
+        .into_par_iter()
+        .filter_map(|i| {
+            let mut rng = Rng::for_sample(0xf17, u64::from(index) << 32 | u64::from(i), 0);
+            sample(&tracer, (index, light_steps, paths), &mut rng)
+        })
+        .collect();
+    Ok(samples)
+}
+
+/// One camera ray's collision and its estimate; None when the ray meets no cloud.
+fn sample(
+    tracer: &PathTracer<cloudscape_reference::CloudMedium>,
+    (index, light_steps, paths): (u32, u32, u32),
+    rng: &mut Rng,
+) -> Option<Sample> {
+    let field = tracer.volume.medium.field();
+    let (bottom_m, top_m) = field.altitude_range_m()?;
+    let sun = tracer.environment.sun?.direction;
+    let (origin, dir) = camera_ray((bottom_m, top_m), rng);
+    let t = tracer.volume.free_flight(origin, dir, RAY_REACH_M, rng)?;
+    let p = origin + dir * t;
+    let to_top = below_altitude(&field.planet, p, sun, top_m).map_or(0.0, |(_, t1)| t1 as f32);
+    let length_m = to_top.clamp(SUN_PATH_M.0, SUN_PATH_M.1);
+    let tau_sun =
+        field.coarse_optical_depth((p, sun), (0.0, length_m, 2.0), (light_steps, 0.5), 0.0);
+    let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+    for _ in 0..paths {
+        let v = f64::from(tracer.source_radiance(p, dir, rng).y);
+        sum += v;
+        sum_sq += v * v;
+    }
+    let n = f64::from(paths);
+    let mean = sum / n;
+    Some(Sample {
+        scene: index,
+        tau_sun,
+        cos_theta: dir.dot(sun),
+        sun_y: sun.y,
+        source: mean as f32,
+        source_error: ((sum_sq / n - mean * mean).max(0.0) / n).sqrt() as f32,
+    })
+}
+
+/// A camera ray: from the ground looking up, from inside the layers, or from above looking down.
+fn camera_ray((bottom_m, top_m): (f32, f32), rng: &mut Rng) -> (Vec3, Vec3) {
+    let place = rng.next_f32();
+    let d = uniform_sphere(rng.next_vec2());
+    let xz = (rng.next_vec2() - 0.5) * CAMERA_SPREAD_M;
+    let (altitude, dir) = if place < 0.4 {
+        (30.0, Vec3::new(d.x, d.y.abs().max(0.03), d.z).normalize())
+    } else if place < 0.7 {
+        (bottom_m + (top_m - bottom_m) * rng.next_f32(), d)
+    } else {
+        let above = top_m + 300.0 + 3000.0 * rng.next_f32();
+        (above, Vec3::new(d.x, -d.y.abs().max(0.03), d.z).normalize())
+    };
+    (Vec3::new(xz.x, altitude, xz.y), dir)
+}
