@@ -9,6 +9,7 @@ mod export;
 mod reference;
 mod render;
 mod report;
+mod view;
 
 use clap::{Parser, Subcommand};
 
@@ -42,6 +43,8 @@ enum Command {
     /// Bake the particle technique's look-up tables (optical depth on the GPU, single and multiple
     /// scattering on the CPU) for a scene into the cache or `--out`, with timings and checks.
     Bake(bake::BakeArgs),
+    /// Fly through a scene in a window: every knob live, what each pass costs on screen.
+    View(view::ViewArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -55,6 +58,7 @@ fn main() -> std::process::ExitCode {
         Command::Report(args) => report::run(args),
         Command::Animate(args) => animate::run(args),
         Command::Bake(args) => bake::run(args),
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

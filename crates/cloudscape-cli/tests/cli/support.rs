@@ -69,11 +69,21 @@ pub struct Run {
 /// Runs `cloudscape args...` in `dir`, with `--backend` from `CLOUDSCAPE_TEST_BACKEND` when set
 /// and `gpu` is true (only the commands that render take it).
 pub fn cloudscape(dir: &Path, args: &[&str], gpu: bool) -> Run {
+    run(command(dir, args, gpu))
+}
+
+/// The command [`cloudscape`] runs, to add to (an environment variable).
+pub fn command(dir: &Path, args: &[&str], gpu: bool) -> Command {
     let mut command = Command::new(env!("CARGO_BIN_EXE_cloudscape"));
     command.current_dir(dir).args(args);
     if let Some(backend) = std::env::var_os(TEST_BACKEND_ENV).filter(|_| gpu) {
         command.arg("--backend").arg(backend);
     }
+    command
+}
+
+/// Runs `command` to its end.
+pub fn run(mut command: Command) -> Run {
     let output = command.output().expect("start the cloudscape binary");
     Run {
         success: output.status.success(),

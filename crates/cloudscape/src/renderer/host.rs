@@ -8,7 +8,9 @@
 
 use super::dispatch;
 use crate::environment::{Environment, EnvironmentGpu, EnvironmentPasses, EnvironmentUniform};
-use crate::field::gpu::{FieldGpu, FieldUpdate};
+pub use crate::field::gpu::FieldUpdate;
+
+use crate::field::gpu::FieldGpu;
 use crate::field::{CloudField, FieldError};
 use crate::frame::{Frame, FrameGpu, Shared};
 use crate::gpu::pipeline::{STORAGE_OUTPUT, texture_2d};
@@ -70,6 +72,20 @@ impl Targets {
             ldr,
         }
     }
+}
+
+/// Whether going from scene `previous` to `next` needs [`CloudRenderer::update_scene`]: a change of
+/// the cloud field (layers, weather, noise, volumes, planet), of the technique, or of the sprite
+/// technique's clouds. Every frame reads the rest (camera, sun, sky, shadow map, ground, phase
+/// function, lighting, particle settings, steps, exposure, tone mapping, time).
+pub fn needs_update(previous: &Scene, next: &Scene) -> bool {
+    fn rebuilt(s: &Scene) -> impl PartialEq + '_ {
+        (
+            (&s.layers, &s.weather, &s.noise, &s.volumes, &s.planet),
+            (s.render.technique, &s.sprites, &s.sprite_clouds),
+        )
+    }
+    rebuilt(previous) != rebuilt(next)
 }
 
 /// Clouds for a host renderer: the field, the shared frame state, the scene's technique and the
@@ -150,6 +166,22 @@ impl CloudRenderer {
         }
         self.reset_history();
         Ok(update)
+    }
+
+    /// Takes a live edit from `previous` to `scene` and rebuilds only what depends on it: calls
+    /// [`CloudRenderer::update_scene`] when [`needs_update`] says so (returning what it did), and
+    /// nothing otherwise, as every frame reads the rest.
+    pub fn apply_edit(
+        &mut self,
+        ctx: &GpuContext,
+        previous: &Scene,
+        scene: &Scene,
+        base_dir: &Path,
+    ) -> Result<Option<FieldUpdate>, FieldError> {
+        if !needs_update(previous, scene) {
+            return Ok(None);
+        }
+        self.update_scene(ctx, scene, base_dir).map(Some)
     }
 
     /// The CPU field drawn (the specification the GPU follows).
@@ -388,5 +420,33 @@ impl CloudRenderer {
         if let Some(t) = self.temporal.as_mut() {
             t.reset();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_the_field_the_technique_and_sprite_clouds_need_an_update() {
+        let base = Scene::default();
+        let changed = |edit: fn(&mut Scene)| {
+            let mut next = base.clone();
+            edit(&mut next);
+            needs_update(&base, &next)
+        };
+        assert!(changed(|s| s.layers[0].coverage = 0.7));
+        assert!(changed(|s| s.noise.seed = 9));
+        assert!(changed(|s| s.planet.radius_m = 1.0e6));
+        assert!(changed(
+            |s| s.render.technique = crate::scene::Technique::Sprites
+        ));
+        assert!(changed(|s| s.sprites.cloud_size_m = 900.0));
+        assert!(!changed(|s| s.sun.elevation_deg = 5.0));
+        assert!(!changed(|s| s.lighting.ambient_scale = 2.0));
+        assert!(!changed(|s| s.render.quality = crate::scene::Quality::Low));
+        assert!(!changed(|s| s.render.exposure_ev = 1.0));
+        assert!(!changed(|s| s.camera.position_m[1] = 900.0));
+        assert!(!changed(|s| s.particles.radius_m = 300.0));
     }
 }
