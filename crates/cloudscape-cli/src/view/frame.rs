@@ -60,7 +60,7 @@ impl Viewer {
             self.capture_window(&ui, &path)?;
         }
         self.window.pre_present_notify();
-        surface.present();
+        self.ctx.queue.present(surface);
         self.read_late_results();
         for request in std::mem::take(&mut ui.output.requests) {
             self.handle(request);
@@ -195,11 +195,12 @@ impl Viewer {
             .encode_finish(&self.ctx, &mut encoder, scene, &host.background(), timer);
         self.timer.resolve_late(&mut encoder);
         let target = surface.texture.create_view(&Default::default());
-        let textures = std::mem::take(&mut self.pending_textures);
+        let mut textures = std::mem::take(&mut self.pending_textures);
         self.encode_window(&mut encoder, &target, ui, &textures);
         self.ctx.queue.submit([encoder.finish()]);
         self.stats.watch_submission(&self.ctx.queue);
         self.presenter.free_textures(&textures);
+        textures.clear();
     }
 
     /// Records the rendered image into its viewport and the panels over it, into `target`.

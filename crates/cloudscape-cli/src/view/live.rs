@@ -120,24 +120,27 @@ impl LiveScene {
     /// Applies `key.path=value` to the live scene, as `--set` does to a file: the value is
     /// checked and a bad one refused with its located error.
     pub fn set(&mut self, assignment: &str) -> Result<(), String> {
-        let key = assignment.split_once('=').map_or(assignment, |(k, _)| k);
+        let key = assignment
+            .split_once('=')
+            .map_or(assignment, |(k, _)| k)
+            .trim();
         let mut base = self.scene.clone();
-        base.settle_edit(key.trim());
-        self.replace(&base, &[assignment.to_string()])
+        base.settle_edit(key);
+        let text = base.to_toml_before_setting(key);
+        self.load_text(&text, &[assignment.to_string()])
     }
 
     /// Takes `edited` (the live scene with the value at `key` changed), checked as a scene file
     /// is; a scene that breaks a rule is refused with the reason.
     pub fn edit(&mut self, mut edited: Scene, key: &str) -> Result<(), String> {
         edited.settle_edit(key);
-        self.replace(&edited, &[])
+        self.load_text(&edited.to_toml(), &[])
     }
 
-    /// Replaces the live scene by `scene` with `overrides`, written out and read back as
-    /// `cloudscape render` would read it, so that what is viewed is what a saved file renders.
-    fn replace(&mut self, scene: &Scene, overrides: &[String]) -> Result<(), String> {
-        let loaded =
-            SceneDocument::parse(&scene.to_toml(), LIVE_ORIGIN, &self.base_dir(), overrides);
+    /// Replaces the live scene by the scene file `text` with `overrides`, read as `cloudscape
+    /// render` would read it, so that what is viewed is what a saved file renders.
+    fn load_text(&mut self, text: &str, overrides: &[String]) -> Result<(), String> {
+        let loaded = SceneDocument::parse(text, LIVE_ORIGIN, &self.base_dir(), overrides);
         match loaded {
             Ok(document) => {
                 self.scene = document.scene;

@@ -47,16 +47,11 @@ impl Presenter {
         let format = egui_wgpu::preferred_framebuffer_format(&capabilities.formats)
             .map_err(|e| anyhow!("the window offers no surface format: {e}"))?;
         let size = window.inner_size();
-        let config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            format,
-            width: size.width.max(1),
-            height: size.height.max(1),
-            present_mode: present_mode(vsync),
-            desired_maximum_frame_latency: 2,
-            alpha_mode: capabilities.alpha_modes[0],
-            view_formats: Vec::new(),
-        };
+        let mut config = surface
+            .get_default_config(ctx.adapter(), size.width.max(1), size.height.max(1))
+            .ok_or_else(|| anyhow!("the adapter cannot present to this window"))?;
+        config.format = format;
+        config.present_mode = present_mode(vsync);
         let panels = egui_wgpu::Renderer::new(&ctx.device, format, Default::default());
         let mut presenter = Presenter {
             blit: Blit::new(ctx, format),
@@ -144,9 +139,11 @@ impl Presenter {
         image: Option<&ViewImage>,
         paint: &PanelPaint,
     ) {
-        for (id, delta) in &paint.textures.set {
-            self.panels
-                .update_texture(&ctx.device, &ctx.queue, *id, delta);
+        for (id, deltas) in &paint.textures.set {
+            for delta in deltas {
+                self.panels
+                    .update_texture(&ctx.device, &ctx.queue, *id, delta);
+            }
         }
         let extra = self.panels.update_buffers(
             &ctx.device,

@@ -19,9 +19,16 @@ impl Scene {
     /// but those derived from another key (the sun's angles from `sun.time_of_day`, the layers and
     /// the visibility from `weather.metar`), which the file must leave out.
     pub fn to_toml(&self) -> String {
+        self.to_toml_before_setting("")
+    }
+
+    /// Like [`Scene::to_toml`], for a file that `--set key=...` will then be applied to: when `key`
+    /// is (or lies within) a key others derive from, the values derived from it are left out too,
+    /// so that the new value takes their place.
+    pub fn to_toml_before_setting(&self, key: &str) -> String {
         let mut table = toml::Table::try_from(self).expect("a scene serialises to a TOML table");
         for (source, derived) in DERIVED {
-            if lookup(&table, source).is_some() {
+            if lookup(&table, source).is_some() || within(key, source) {
                 derived.iter().for_each(|key| remove(&mut table, key));
             }
         }
@@ -115,6 +122,17 @@ mod tests {
             }
         }
         assert!(count >= 8, "only {count} scenes found");
+    }
+
+    #[test]
+    fn a_file_written_before_setting_a_source_leaves_its_derived_values_out() {
+        let text = Scene::default().to_toml_before_setting("weather.metar");
+        let report = "weather.metar=\"EDDM 011750Z 24012KT 9999 FEW040 18/12 Q1012\"";
+        let scene = SceneDocument::parse(&text, "saved", Path::new(""), &[report.to_string()])
+            .unwrap()
+            .scene;
+        assert!(scene.weather.metar.is_some());
+        assert_ne!(scene.layers, Scene::default().layers);
     }
 
     #[test]
