@@ -24,10 +24,13 @@ pub struct Setup {
     pub gpu: GpuOptions,
     /// The window's first inner size, pixels.
     pub window_size: [u32; 2],
-    /// `--render-scale`; None picks by adapter.
+    /// `--render-scale`; None picks by adapter (1/4 on a software adapter).
     pub render_scale: Option<f32>,
-    /// Temporal reuse at the start; None for off.
+    /// Temporal reuse at the start; None for off. Without `--temporal`, one ray per 2x2 pixels
+    /// (4x4 on a software adapter).
     pub temporal: Option<TemporalSettings>,
+    /// Whether the command line chose the temporal reuse.
+    pub temporal_given: bool,
     /// Vsync at the start.
     pub vsync: bool,
     /// Panels shown at the start.
@@ -38,12 +41,15 @@ pub struct Setup {
     pub screenshot: Option<PathBuf>,
     /// Timed actions.
     pub script: Script,
+    /// Whether the command line chose `render.quality` (else a software adapter starts at low).
+    pub quality_given: bool,
 }
 
 impl Setup {
     /// Reads the scene and the script; every error is reported before a window opens.
     pub fn from_args(args: ViewArgs) -> Result<Setup> {
-        let live = LiveScene::load(args.scene.scene.as_deref(), &args.scene.all_overrides())?;
+        let overrides = args.scene.all_overrides();
+        let live = LiveScene::load(args.scene.scene.as_deref(), &overrides)?;
         let script = match &args.script {
             Some(path) => Script::read(path)?,
             None => Script::default(),
@@ -60,6 +66,7 @@ impl Setup {
         let divisor = args
             .temporal
             .map_or(Some(TemporalSettings::default().divisor), |t| t.0);
+        let temporal_given = args.temporal.is_some();
         Ok(Setup {
             window_size: [render.width, render.height],
             gpu: args.gpu.options(),
@@ -68,11 +75,15 @@ impl Setup {
                 divisor,
                 ..TemporalSettings::default()
             }),
+            temporal_given,
             vsync: !args.no_vsync,
             panels: !args.hide_panels,
             frames: args.frames,
             screenshot: args.screenshot,
             script,
+            quality_given: overrides
+                .iter()
+                .any(|o| o.trim_start().starts_with("render.quality")),
             live,
         })
     }

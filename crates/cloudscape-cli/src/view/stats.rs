@@ -22,6 +22,9 @@ pub struct FrameTime {
 pub struct FrameStats {
     frames: VecDeque<FrameTime>,
     last_start: Option<Instant>,
+    /// The first frame's start, and the frames started since.
+    first_start: Option<Instant>,
+    count: u64,
     /// Completion times of submitted frames, pushed by the queue's callbacks.
     done: Arc<Mutex<VecDeque<(Instant, Instant)>>>,
     /// When the GPU last finished a frame.
@@ -36,6 +39,8 @@ impl FrameStats {
         FrameStats {
             frames: VecDeque::new(),
             last_start: None,
+            first_start: None,
+            count: 0,
             done: Arc::new(Mutex::new(VecDeque::new())),
             last_done: None,
             gpu_wall_ms: None,
@@ -45,6 +50,8 @@ impl FrameStats {
     /// Marks the start of a frame.
     pub fn start_frame(&mut self) {
         let now = Instant::now();
+        self.first_start.get_or_insert(now);
+        self.count += 1;
         if let Some(last) = self.last_start {
             self.frames.push_back(FrameTime {
                 at: now,
@@ -86,6 +93,24 @@ impl FrameStats {
     /// The frames of the last [`HISTORY`], oldest first.
     pub fn frames(&self) -> &VecDeque<FrameTime> {
         &self.frames
+    }
+
+    /// The whole run in words: frames, mean frame time and rate since the first frame (the first
+    /// frame's set-up included), and the GPU's newest wall time.
+    pub fn summary(&self) -> String {
+        let elapsed_s = self
+            .first_start
+            .map_or(0.0, |first| first.elapsed().as_secs_f64());
+        let frames = self.count.max(1) as f64;
+        let gpu = self.gpu_wall_ms.map_or(String::new(), |ms| {
+            format!(", GPU wall {ms:.1} ms per frame")
+        });
+        format!(
+            "{} frames in {elapsed_s:.2} s: {:.1} ms per frame, {:.2} fps{gpu}",
+            self.count,
+            elapsed_s * 1e3 / frames,
+            frames / elapsed_s.max(1e-9)
+        )
     }
 
     /// Mean frame time over the last second, ms.

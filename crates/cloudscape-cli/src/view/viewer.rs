@@ -9,6 +9,7 @@ use anyhow::{Context, Result};
 use cloudscape::gpu::{GpuContext, PassTimer};
 use cloudscape::renderer::{CloudRenderer, PASS_COUNT};
 use cloudscape::technique::TechniqueStats;
+use cloudscape::temporal::TemporalSettings;
 use glam::Vec2;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, KeyEvent, MouseButton, MouseScrollDelta, WindowEvent};
@@ -31,6 +32,33 @@ pub const SCRIPTED_FRAME_S: f32 = 1.0 / 30.0;
 pub const MAX_FRAME_S: f32 = 0.1;
 /// Pixels the wheel scrolls per notch, when it reports pixels.
 const PIXELS_PER_NOTCH: f64 = 40.0;
+
+/// Render scale on a software adapter, unless `--render-scale` says otherwise.
+const SOFTWARE_SCALE: f32 = 0.25;
+/// Temporal grid on a software adapter, unless `--temporal` says otherwise: one ray per 4x4 pixels.
+const SOFTWARE_DIVISOR: u32 = 4;
+
+/// On a software adapter (a CPU emulating a GPU, tens of times slower), start where it is
+/// interactive: one ray per 4x4 pixels per frame and `render.quality = low`, unless the command
+/// line chose them; the panel raises them.
+fn software_defaults(setup: &mut Setup) {
+    if !setup.temporal_given {
+        setup.temporal = setup.temporal.map(|t| TemporalSettings {
+            divisor: SOFTWARE_DIVISOR,
+            ..t
+        });
+    }
+    if !setup.quality_given {
+        match setup.live.set("render.quality=low") {
+            Ok(()) => eprintln!(
+                "a software adapter: starting at render.quality=low and one ray per \
+                 {SOFTWARE_DIVISOR}x{SOFTWARE_DIVISOR} pixels (--set render.quality=..., \
+                 --temporal N, or the panel, to choose)"
+            ),
+            Err(error) => eprintln!("warning: {error}"),
+        }
+    }
+}
 
 /// The viewer and everything it holds.
 pub struct Viewer {
@@ -88,12 +116,16 @@ impl Viewer {
             None,
             Some(ctx.max_texture_dimension_2d() as usize),
         );
+        let software = ctx.adapter_info().device_type == wgpu::DeviceType::Cpu;
+        let mut setup = setup;
+        if software {
+            software_defaults(&mut setup);
+        }
         let live = setup.live;
         let clouds = CloudRenderer::new(&ctx, &live.scene, &live.base_dir())
             .map_err(|e| live.field_error(e))
             .context("while building the cloud field")?;
-        let software = ctx.adapter_info().device_type == wgpu::DeviceType::Cpu;
-        let default_scale = if software { 0.25 } else { 1.0 };
+        let default_scale = if software { SOFTWARE_SCALE } else { 1.0 };
         Ok(Viewer {
             timer: PassTimer::new(&ctx, PASS_COUNT),
             rig: CameraRig::new(&live.scene.camera),

@@ -2,7 +2,8 @@
 //! frames, writes its screenshot and exits; the screenshot matches a golden by FLIP, a scripted
 //! knob change changes it, and a saved scene renders exactly as it was viewed.
 //!
-//! The window is 320x180 at render scale 1/2 (160x90 rendered) with the panels hidden, low quality.
+//! The window is 320x180 at render scale 1/2 (160x90 rendered) with the panels hidden, low quality,
+//! one ray per 2x2 pixels per frame (or none, for the saved scene).
 
 use std::path::Path;
 
@@ -49,7 +50,8 @@ fn write(scratch: &Scratch, name: &str, text: &str) {
 #[test]
 fn view_renders_its_frames_in_a_window_and_matches_its_golden() {
     let scratch = Scratch::new("view-golden");
-    let run = view(scratch.path(), &["--screenshot", "shot.png"]);
+    let args = ["--temporal", "2", "--screenshot", "shot.png"];
+    let run = view(scratch.path(), &args);
     assert!(run.stderr.contains("adapter: "), "{}", run.stderr);
     let shot = LdrImage::read_png(&scratch.join("shot.png")).expect("the screenshot");
     assert_eq!((shot.width, shot.height), (160, 90));
@@ -66,12 +68,20 @@ fn a_scripted_coverage_change_changes_the_image() {
     write(&scratch, "script.toml", script);
     view(
         scratch.path(),
-        &["--script", "script.toml", "--screenshot", "shot.png"],
+        &[
+            "--temporal",
+            "2",
+            "--script",
+            "script.toml",
+            "--screenshot",
+            "shot.png",
+        ],
     );
     let changed = LdrImage::read_png(&scratch.join("shot.png")).expect("the screenshot");
     let golden_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/view_default.png");
     let unchanged = LdrImage::read_png(&golden_path).expect("the golden of the unchanged scene");
     let (stats, _) = flip(&unchanged, &changed).expect("same size");
+    eprintln!("coverage 0.45 -> 0.95: FLIP mean {:.4}", stats.mean);
     assert!(
         stats.mean > 0.1,
         "coverage 0.45 -> 0.95 changed the image by FLIP {:.4} only",

@@ -19,7 +19,7 @@ use crate::output::{CloudOutput, SampleGrid};
 use crate::post::upsample::Upsampler;
 use crate::post::{Background, Compositor, DISPLAY_FORMAT, Display, HDR_FORMAT};
 use crate::scene::Scene;
-use crate::shadow::ShadowParams;
+use crate::shadow::{BuiltShadow, ShadowParams, ShadowReuse};
 use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use crate::temporal::{TemporalResolve, TemporalSettings};
 use glam::{UVec2, Vec2};
@@ -106,6 +106,11 @@ pub struct CloudRenderer {
     targets: Option<Targets>,
     frame: Option<Frame>,
     reuse: Reuse,
+    /// Whether the shadow map may be kept across frames, what the current one was built for, and
+    /// whether this frame builds it.
+    shadow_reuse: Option<ShadowReuse>,
+    shadow_built: Option<BuiltShadow>,
+    shadow_rebuild: bool,
 }
 
 impl CloudRenderer {
@@ -144,6 +149,9 @@ impl CloudRenderer {
             targets: None,
             frame: None,
             reuse: Reuse::None,
+            shadow_reuse: None,
+            shadow_built: None,
+            shadow_rebuild: true,
         })
     }
 
@@ -164,6 +172,7 @@ impl CloudRenderer {
         if sprites || self.technique.name() != scene.render.technique.name() {
             self.technique = dispatch::build(ctx, &self.shared(), scene, base_dir)?;
         }
+        self.shadow_built = None;
         self.reset_history();
         Ok(update)
     }
@@ -267,7 +276,7 @@ impl CloudRenderer {
         self.frame_gpu.write(ctx, &frame.uniform(&grid));
         let env = Environment::from_scene(scene);
         let viewpoint = frame.camera_position_m;
-        let shadow = ShadowParams::new(scene, &self.field, viewpoint, env.sun.direction);
+        let shadow = self.frame_shadow(scene, &env, frame);
         self.environment_gpu
             .resize_shadow_map(ctx, scene.shadow.resolution);
         let uniform = EnvironmentUniform::new(&env, viewpoint, &shadow);
@@ -282,6 +291,41 @@ impl CloudRenderer {
         self.technique.prepare(ctx, &inputs);
         self.frame = Some(frame.clone());
         self.reuse = reuse;
+    }
+
+    /// The shadow map this frame reads: the one built before, when [`ShadowReuse`] allows it,
+    /// else a new one (and the frame's environment passes build it).
+    fn frame_shadow(&mut self, scene: &Scene, env: &Environment, frame: &Frame) -> ShadowParams {
+        let sun = env.sun.direction;
+        let fresh = BuiltShadow {
+            params: ShadowParams::new(scene, &self.field, frame.camera_position_m, sun),
+            sun,
+            texels: scene.shadow.resolution,
+            time_s: frame.time_s,
+        };
+        let wind = self.wind_m_per_s();
+        let kept = match (self.shadow_reuse, &self.shadow_built) {
+            (Some(reuse), Some(built)) if built.serves(&fresh, wind, reuse) => Some(*built),
+            _ => None,
+        };
+        self.shadow_rebuild = kept.is_none();
+        let used = kept.unwrap_or(fresh);
+        self.shadow_built = Some(used);
+        used.params
+    }
+
+    /// The wind of the first layer, which carries the clouds (zero without layers).
+    fn wind_m_per_s(&self) -> Vec2 {
+        self.field
+            .layers
+            .first()
+            .map_or(Vec2::ZERO, |l| l.wind_m_per_s)
+    }
+
+    /// Lets the clouds' shadow map be reused across frames (see [`ShadowReuse`]), or, with None,
+    /// rebuilt every frame (the default, as offline renders need).
+    pub fn set_shadow_reuse(&mut self, reuse: Option<ShadowReuse>) {
+        self.shadow_reuse = reuse;
     }
 
     /// Records the technique over output texels `region` (origin, size; None for all of them),
@@ -333,7 +377,7 @@ impl CloudRenderer {
             environment: &self.environment_gpu,
         };
         self.environment_passes
-            .encode(ctx, encoder, &shared, env, timer);
+            .encode(ctx, encoder, &shared, (env, self.shadow_rebuild), timer);
         *pending = false;
     }
 
@@ -358,13 +402,9 @@ impl CloudRenderer {
             .targets
             .as_ref()
             .expect("begin_frame makes the targets");
+        let wind = self.wind_m_per_s();
         let clouds = match (self.reuse, self.temporal.as_mut()) {
             (Reuse::Temporal(_), Some(temporal)) => {
-                let wind = self
-                    .field
-                    .layers
-                    .first()
-                    .map_or(Vec2::ZERO, |l| l.wind_m_per_s);
                 let inputs = (&t.output, background.depth);
                 let timer = timer.as_deref_mut();
                 temporal.encode(ctx, encoder, &shared, (frame, wind), inputs, timer)
