@@ -54,13 +54,13 @@ impl Setup {
             Some(path) => Script::read(path)?,
             None => Script::default(),
         };
-        if let (Some(last), Some(frames)) = (script.last_frame(), args.frames) {
-            if last >= frames {
-                return Err(anyhow!(
-                    "the script has a step at frame {last}, past the last of --frames {frames} \
-                     (frames count from 0)"
-                ));
-            }
+        if let (Some(last), Some(frames)) = (script.last_frame(), args.frames)
+            && last >= frames
+        {
+            return Err(anyhow!(
+                "the script has a step at frame {last}, past the last of --frames {frames} \
+                 (frames count from 0)"
+            ));
         }
         let render = &live.scene.render;
         let divisor = args

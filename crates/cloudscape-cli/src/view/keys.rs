@@ -7,8 +7,11 @@ use winit::keyboard::KeyCode;
 
 use super::camera::Motion;
 
-/// Each movement key: its name in scripts, its key code, and what it adds to a [`Motion`].
-const MOVEMENT_KEYS: [(&str, KeyCode, fn(&mut Motion)); 8] = [
+/// A movement key: its name in scripts, its key code, and what it adds to a [`Motion`].
+type MovementKey = (&'static str, KeyCode, fn(&mut Motion));
+
+/// Every movement key.
+const MOVEMENT_KEYS: [MovementKey; 8] = [
     ("w", KeyCode::KeyW, |m| m.forward += 1.0),
     ("s", KeyCode::KeyS, |m| m.forward -= 1.0),
     ("d", KeyCode::KeyD, |m| m.right += 1.0),
