@@ -75,19 +75,8 @@ fn section(
         let rows = knobs::SCENE
             .iter()
             .filter(|k| k.key.split('.').next() == Some(name));
-        grid(ui, name, |ui| {
-            for knob in rows {
-                let place = Place {
-                    key: knob.key.to_string(),
-                    label: &knob.key[name.len() + 1..],
-                };
-                let fallback = resolved(knob.key, scene);
-                if row(ui, knob, &place, scene, fallback) {
-                    changed = Some(place.key);
-                }
-            }
-        });
-        changed
+        let skip = name.len() + 1;
+        changed.or(knob_grid(ui, name, rows, ("", skip), scene, resolved))
     });
     shown.header_response.on_hover_text(hover);
     shown.body_returned.flatten()
@@ -107,17 +96,9 @@ fn time_of_day(ui: &mut egui::Ui, scene: &mut Scene) -> Option<String> {
         changed = Some("sun.time_of_day".to_string());
     }
     if let Some(time) = scene.sun.time_of_day.as_mut() {
-        grid(ui, "time of day", |ui| {
-            for knob in knobs::TIME_OF_DAY {
-                let place = Place {
-                    key: format!("sun.time_of_day.{}", knob.key),
-                    label: knob.key,
-                };
-                if row(ui, knob, &place, time, None) {
-                    changed = Some(place.key);
-                }
-            }
-        });
+        let rows = knobs::TIME_OF_DAY.iter();
+        let prefix = ("sun.time_of_day.", 0);
+        changed = changed.or(knob_grid(ui, "time of day", rows, prefix, time, &|_, _| None));
     }
     changed
 }
@@ -137,23 +118,41 @@ fn layer_sections(ui: &mut egui::Ui, scene: &mut Scene) -> Option<String> {
     for (index, layer) in scene.layers.iter_mut().enumerate() {
         let header =
             egui::CollapsingHeader::new(format!("layers.{index}")).default_open(index == 0);
-        header
-            .show(ui, |ui| {
-                grid(ui, &format!("layer {index}"), |ui| {
-                    for knob in knobs::LAYER {
-                        let place = Place {
-                            key: format!("layers.{index}.{}", knob.key),
-                            label: knob.key,
-                        };
-                        if row(ui, knob, &place, layer, None) {
-                            changed = Some(place.key);
-                        }
-                    }
-                });
-            })
-            .header_response
-            .on_hover_text(hover);
+        let shown = header.show(ui, |ui| {
+            let prefix = format!("layers.{index}.");
+            let rows = knobs::LAYER.iter();
+            knob_grid(ui, &prefix, rows, (&prefix, 0), layer, &|_, _| None)
+        });
+        shown.header_response.on_hover_text(hover);
+        changed = changed.or(shown.body_returned.flatten());
     }
+    changed
+}
+
+/// A grid of knob rows, one per knob of `knobs` in `item`: each named by its key with the first
+/// `skip` characters left out, and reported by its key after `prefix`. `fallback` gives the value
+/// an unset optional knob takes. Returns the full key of the knob changed, if one was.
+fn knob_grid<'k, T: 'static>(
+    ui: &mut egui::Ui,
+    id: &str,
+    knobs: impl Iterator<Item = &'k Knob<T>>,
+    (prefix, skip): (&str, usize),
+    item: &mut T,
+    fallback: &dyn Fn(&str, &T) -> Option<u32>,
+) -> Option<String> {
+    let mut changed = None;
+    grid(ui, id, |ui| {
+        for knob in knobs {
+            let place = Place {
+                key: format!("{prefix}{}", knob.key),
+                label: &knob.key[skip..],
+            };
+            let preset = fallback(&place.key, item);
+            if row(ui, knob, &place, item, preset) {
+                changed = Some(place.key);
+            }
+        }
+    });
     changed
 }
 
