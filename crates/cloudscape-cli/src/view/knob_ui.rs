@@ -98,7 +98,9 @@ fn time_of_day(ui: &mut egui::Ui, scene: &mut Scene) -> Option<String> {
     if let Some(time) = scene.sun.time_of_day.as_mut() {
         let rows = knobs::TIME_OF_DAY.iter();
         let prefix = ("sun.time_of_day.", 0);
-        changed = changed.or(knob_grid(ui, "time of day", rows, prefix, time, &|_, _| None));
+        changed = changed.or(knob_grid(ui, "time of day", rows, prefix, time, &|_, _| {
+            None
+        }));
     }
     changed
 }

@@ -94,8 +94,9 @@ fn a_built_map_serves_until_the_eye_and_the_clouds_drift_too_far() {
         let a = built.params.ground_point((i, 0), 256).x;
         built.params.ground_point((i + 1, 0), 256).x - a
     };
+    // The texel beside the centre is a little larger: the warp grows away from it.
     assert!(
-        (texel(128) - texel_m).abs() < 0.01 * texel_m,
+        (texel(128) - texel_m).abs() < 0.05 * texel_m,
         "{} {texel_m}",
         texel(128)
     );
