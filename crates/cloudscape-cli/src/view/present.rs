@@ -32,6 +32,9 @@ pub struct Presenter {
     config: wgpu::SurfaceConfiguration,
     blit: Blit,
     panels: egui_wgpu::Renderer,
+    /// The swapchain no longer matches the window: configure it before the next image (not while
+    /// an image of it is held).
+    stale: bool,
 }
 
 impl Presenter {
@@ -59,6 +62,7 @@ impl Presenter {
             surface,
             config,
             panels,
+            stale: false,
         };
         presenter.configure(ctx);
         Ok(presenter)
@@ -100,10 +104,13 @@ impl Presenter {
         if !self.visible() {
             return None;
         }
+        if std::mem::take(&mut self.stale) {
+            self.configure(ctx);
+        }
         match self.surface.get_current_texture() {
             Current::Success(texture) => Some(texture),
             Current::Suboptimal(texture) => {
-                self.configure(ctx);
+                self.stale = true;
                 Some(texture)
             }
             Current::Outdated => {

@@ -11,6 +11,7 @@
 //! hold = ["w", "shift"]        # keys held from this frame on (until a later `hold`)
 //! orbit = true                 # orbit the point ahead (false: fly)
 //! render_scale = 0.5           # 1, 0.5 or 0.25
+//! window_size = [640, 360]     # asks the window system for this inner size, pixels
 //! reset_camera = true          # back to the scene's camera
 //! screenshot = "frame4.png"    # after the frame: its PNG and EXR
 //! window_screenshot = "w.png"  # after the frame: the whole window, panels included
@@ -63,6 +64,8 @@ pub struct Step {
     pub orbit: Option<bool>,
     /// Render scale: 1, 0.5 or 0.25.
     pub render_scale: Option<f32>,
+    /// Asks the window system for this inner size of the window, pixels.
+    pub window_size: Option<[u32; 2]>,
     /// Back to the scene's camera.
     #[serde(default)]
     pub reset_camera: bool,

@@ -313,6 +313,12 @@ impl Viewer {
             if let Some(scale) = step.render_scale {
                 self.view.render_scale = scale;
             }
+            if let Some([width, height]) = step.window_size {
+                // The window system answers with a resize event in a later frame.
+                let _ = self
+                    .window
+                    .request_inner_size(PhysicalSize::new(width, height));
+            }
         }
         Ok(())
     }

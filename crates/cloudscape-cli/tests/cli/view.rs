@@ -115,3 +115,17 @@ fn a_saved_scene_renders_exactly_as_it_was_viewed() {
     let saved = std::fs::read_to_string(scratch.join("saved.toml")).expect("the saved scene");
     assert!(saved.contains("exposure_ev = 0.5"), "{saved}");
 }
+
+#[test]
+fn the_render_follows_the_window_when_it_is_resized() {
+    let scratch = Scratch::new("view-resize");
+    write(
+        &scratch,
+        "script.toml",
+        "[[at]]\nframe = 3\nwindow_size = [240, 100]\n",
+    );
+    let args = ["--script", "script.toml", "--screenshot", "shot.png"];
+    view(scratch.path(), &args);
+    let shot = LdrImage::read_png(&scratch.join("shot.png")).expect("the screenshot");
+    assert_eq!((shot.width, shot.height), (120, 50));
+}
