@@ -135,22 +135,15 @@ impl Panel {
     /// The buttons, and the file names they write to.
     fn actions(&mut self, ui: &mut egui::Ui, mode: &Mode, output: &mut PanelOutput) {
         ui.heading("cloudscape view");
-        ui.horizontal(|ui| {
-            if ui.button("Save scene").clicked() {
-                output
-                    .requests
-                    .push(Request::Save(self.save_path.clone().into()));
-            }
-            ui.text_edit_singleline(&mut self.save_path);
-        });
-        ui.horizontal(|ui| {
-            if ui.button("Screenshot").clicked() {
-                output
-                    .requests
-                    .push(Request::Screenshot(self.screenshot_path.clone().into()));
-            }
-            ui.text_edit_singleline(&mut self.screenshot_path);
-        });
+        if file_button(ui, "Save scene", &mut self.save_path) {
+            output
+                .requests
+                .push(Request::Save(self.save_path.clone().into()));
+        }
+        if file_button(ui, "Screenshot (P)", &mut self.screenshot_path) {
+            let path = self.screenshot_path.clone().into();
+            output.requests.push(Request::Screenshot(path));
+        }
         ui.horizontal(|ui| {
             if ui
                 .button("Reset camera")
@@ -173,6 +166,16 @@ impl Panel {
             ui.weak(&self.status);
         }
     }
+}
+
+/// A button beside the name of the file it writes; true when pressed.
+fn file_button(ui: &mut egui::Ui, label: &str, path: &mut String) -> bool {
+    ui.horizontal(|ui| {
+        let pressed = ui.button(label).clicked();
+        ui.text_edit_singleline(path);
+        pressed
+    })
+    .inner
 }
 
 /// The step count a quality preset gives an unset step knob.

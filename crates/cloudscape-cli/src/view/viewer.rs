@@ -197,6 +197,7 @@ impl Viewer {
             } => {
                 let over_panels = self.egui.egui_ctx().egui_wants_pointer_input();
                 self.mouse_look = *state == ElementState::Pressed && !over_panels;
+                self.window.set_cursor_visible(!self.mouse_look);
             }
             WindowEvent::MouseWheel { delta, .. } if !consumed => {
                 let notches = match delta {
