@@ -30,8 +30,9 @@ pub struct SceneArgs {
 }
 
 impl SceneArgs {
-    /// Loads and validates the scene with every override applied.
-    pub fn load(&self, extra: &[String]) -> Result<SceneDocument> {
+    /// Every override, in order: `--set`, then `--width`, `--height` and `--technique` as the
+    /// `--set` they stand for.
+    pub fn all_overrides(&self) -> Vec<String> {
         let mut overrides = self.overrides.clone();
         overrides.extend(self.width.map(|w| format!("render.width={w}")));
         overrides.extend(self.height.map(|h| format!("render.height={h}")));
@@ -40,6 +41,12 @@ impl SceneArgs {
                 .as_ref()
                 .map(|t| format!("render.technique={t}")),
         );
+        overrides
+    }
+
+    /// Loads and validates the scene with every override applied, then `extra`.
+    pub fn load(&self, extra: &[String]) -> Result<SceneDocument> {
+        let mut overrides = self.all_overrides();
         overrides.extend_from_slice(extra);
         Ok(SceneDocument::load(self.scene.as_deref(), &overrides)?)
     }
@@ -57,13 +64,17 @@ pub struct GpuArgs {
 }
 
 impl GpuArgs {
-    /// Opens the GPU, prints which adapter it is, and checks the scene's image fits its limits.
-    pub fn open(&self, doc: &SceneDocument) -> Result<GpuContext> {
-        let options = GpuOptions {
+    /// The adapter choice these arguments ask for.
+    pub fn options(&self) -> GpuOptions {
+        GpuOptions {
             backend: self.backend,
             adapter_substring: self.adapter.clone(),
-        };
-        let ctx = GpuContext::new(&options)?;
+        }
+    }
+
+    /// Opens the GPU, prints which adapter it is, and checks the scene's image fits its limits.
+    pub fn open(&self, doc: &SceneDocument) -> Result<GpuContext> {
+        let ctx = GpuContext::new(&self.options())?;
         eprintln!("adapter: {}", ctx.summary());
         let max = ctx.max_texture_dimension_2d();
         for (key, value) in [

@@ -12,6 +12,7 @@ mod reference;
 mod render;
 mod report;
 mod runtime_dir;
+mod view;
 
 use clap::{Parser, Subcommand};
 
@@ -48,6 +49,8 @@ enum Command {
     /// Bake the particle technique's look-up tables (optical depth on the GPU, single and multiple
     /// scattering on the CPU) for a scene into the cache or `--out`, with timings and checks.
     Bake(bake::BakeArgs),
+    /// Fly through a scene in a window: every knob live, what each pass costs on screen.
+    View(view::ViewArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -67,6 +70,7 @@ fn main() -> std::process::ExitCode {
         Command::FitLighting(args) => fit_lighting::run(args),
         Command::Animate(args) => animate::run(args),
         Command::Bake(args) => bake::run(args),
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -11,3 +11,9 @@ mod commands;
 mod faults;
 mod reference;
 mod support;
+mod view;
+mod xvfb;
+
+/// FLIP against goldens in `tests/golden/`, shared with the library's golden tests.
+#[path = "../../../cloudscape/tests/support/mod.rs"]
+mod golden;

@@ -34,17 +34,20 @@ impl EnvironmentPasses {
         names
     }
 
-    /// Records the frame's passes for `env` (the uniform already written).
+    /// Records the frame's passes for `env` (the uniform already written): the shadow map when
+    /// `build_shadow` (else the one built before is read), and the sky's tables.
     pub fn encode(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         shared: &Shared,
-        env: &Environment,
+        (env, build_shadow): (&Environment, bool),
         mut timer: Option<&mut PassTimer>,
     ) {
-        self.shadow
-            .encode(ctx, encoder, shared, timer.as_deref_mut());
+        if build_shadow {
+            self.shadow
+                .encode(ctx, encoder, shared, timer.as_deref_mut());
+        }
         if env.sky_model == SkyModel::Atmosphere {
             self.atmosphere
                 .encode(ctx, encoder, shared, &env.air, timer);

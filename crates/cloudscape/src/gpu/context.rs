@@ -97,6 +97,13 @@ pub enum GpuError {
         /// The adapters that were seen and why each was rejected, or that none was seen.
         seen: String,
     },
+    /// The window system refused a surface to present to.
+    #[error("cannot present to the window: {source}")]
+    CreateSurface {
+        /// wgpu's reason.
+        #[source]
+        source: wgpu::CreateSurfaceError,
+    },
     /// The chosen adapter refused to open a device.
     #[error("the GPU adapter {adapter} could not open a device: {source}")]
     RequestDevice {
@@ -119,7 +126,7 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
     adapter: wgpu::Adapter,
     info: wgpu::AdapterInfo,
-    /// The instance the adapter came from, when this context made it (not a host's device).
+    /// The instance the adapter came from; None for a host's own device.
     instance: Option<wgpu::Instance>,
 }
 
@@ -131,15 +138,73 @@ impl GpuContext {
     }
 
     async fn new_async(options: &GpuOptions) -> Result<GpuContext, GpuError> {
-        let (instance, adapter) = match options.backend {
-            Some(backend) => find_adapter(backend.to_wgpu(), options).await?,
-            // GL is probed only when no native API offers an adapter: its probe of the display
-            // servers is slow and, without XDG_RUNTIME_DIR, prints a frightening libwayland error.
-            None => match find_adapter(native_backends(), options).await {
-                Ok(found) => found,
-                Err(_) => find_adapter(all_backends(), options).await?,
-            },
-        };
+        let without_display = wgpu::InstanceDescriptor::new_without_display_handle;
+        if options.backend.is_some() {
+            return Self::open(
+                instance(backends(options), without_display()),
+                options,
+                None,
+            )
+            .await;
+        }
+        // GL is probed only when no native API offers an adapter: its probe of the display
+        // servers is slow and, without XDG_RUNTIME_DIR, prints a frightening libwayland error.
+        match Self::open(
+            instance(native_backends(), without_display()),
+            options,
+            None,
+        )
+        .await
+        {
+            Err(GpuError::NoAdapter { .. }) => {
+                Self::open(instance(all_backends(), without_display()), options, None).await
+            }
+            opened => opened,
+        }
+    }
+
+    /// Like [`GpuContext::new`], for a window: the instance is made with the window system's
+    /// `display` (GL presents through it), a surface is made for `window`, and only adapters that
+    /// can present to it are considered.
+    pub fn with_surface(
+        options: &GpuOptions,
+        display: Box<dyn wgpu::wgt::WgpuHasDisplayHandle>,
+        window: impl Into<wgpu::SurfaceTarget<'static>>,
+    ) -> Result<(GpuContext, wgpu::Surface<'static>), GpuError> {
+        let descriptor = wgpu::InstanceDescriptor::new_with_display_handle(display);
+        let instance = instance(backends(options), descriptor);
+        let surface = instance
+            .create_surface(window)
+            .map_err(|source| GpuError::CreateSurface { source })?;
+        let context = pollster::block_on(Self::open(instance, options, Some(&surface)))?;
+        Ok((context, surface))
+    }
+
+    /// A new surface for `window` on this context's instance, to replace a lost one.
+    ///
+    /// # Panics
+    /// For a context made by [`GpuContext::from_wgpu`], which has no instance.
+    pub fn create_surface(
+        &self,
+        window: impl Into<wgpu::SurfaceTarget<'static>>,
+    ) -> Result<wgpu::Surface<'static>, GpuError> {
+        let instance = self
+            .instance
+            .as_ref()
+            .expect("a context made by GpuContext::new");
+        instance
+            .create_surface(window)
+            .map_err(|source| GpuError::CreateSurface { source })
+    }
+
+    /// Picks the adapter (one that presents to `surface`, when given) and opens a device on it.
+    async fn open(
+        instance: wgpu::Instance,
+        options: &GpuOptions,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<GpuContext, GpuError> {
+        let adapters = instance.enumerate_adapters(backends(options)).await;
+        let adapter = choose_adapter(adapters, options, surface)?;
         let info = adapter.get_info();
         let (device, queue) = adapter
             .request_device(&device_descriptor(&adapter))
@@ -174,6 +239,11 @@ impl GpuContext {
             info,
             instance: None,
         }
+    }
+
+    /// The chosen adapter (a window's surface asks it what it can present).
+    pub fn adapter(&self) -> &wgpu::Adapter {
+        &self.adapter
     }
 
     /// The chosen adapter's name, backend, type and driver.
@@ -238,18 +308,16 @@ impl GpuContext {
     }
 }
 
-/// An instance of `backends` and the adapter [`choose_adapter`] picks among its adapters.
-async fn find_adapter(
-    backends: wgpu::Backends,
-    options: &GpuOptions,
-) -> Result<(wgpu::Instance, wgpu::Adapter), GpuError> {
-    let mut instance_descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
-    instance_descriptor.backends = backends;
-    instance_descriptor.flags = instance_descriptor.flags.with_env();
-    let instance = wgpu::Instance::new(instance_descriptor);
-    let adapters = instance.enumerate_adapters(backends).await;
-    let adapter = choose_adapter(adapters, options)?;
-    Ok((instance, adapter))
+/// An instance of `backends`, with wgpu's debugging flags from the environment.
+fn instance(backends: wgpu::Backends, mut descriptor: wgpu::InstanceDescriptor) -> wgpu::Instance {
+    descriptor.backends = backends;
+    descriptor.flags = descriptor.flags.with_env();
+    wgpu::Instance::new(descriptor)
+}
+
+/// The backends `options` allow.
+fn backends(options: &GpuOptions) -> wgpu::Backends {
+    options.backend.map_or(all_backends(), Backend::to_wgpu)
 }
 
 /// Every backend but GL.
@@ -283,17 +351,16 @@ fn describe(info: &wgpu::AdapterInfo) -> String {
     format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
 }
 
-/// Keeps the adapters whose name matches, then takes the best by [`rank`]; the first wins a tie.
+/// Keeps the adapters whose name matches (and that present to `surface`, when given), then takes
+/// the best by [`rank`]; the first wins a tie.
 fn choose_adapter(
     adapters: Vec<wgpu::Adapter>,
     options: &GpuOptions,
+    surface: Option<&wgpu::Surface<'_>>,
 ) -> Result<wgpu::Adapter, GpuError> {
-    let wanted = options.adapter_substring.as_deref().map(str::to_lowercase);
-    let (matching, rejected): (Vec<_>, Vec<_>) = adapters.into_iter().partition(|adapter| {
-        wanted
-            .as_deref()
-            .is_none_or(|text| adapter.get_info().name.to_lowercase().contains(text))
-    });
+    let (matching, rejected): (Vec<_>, Vec<_>) = adapters
+        .into_iter()
+        .partition(|adapter| rejection(adapter, options, surface).is_none());
     let key = |adapter: &wgpu::Adapter| {
         let info = adapter.get_info();
         rank(info.device_type, info.backend)
@@ -302,8 +369,23 @@ fn choose_adapter(
         .into_iter()
         .min_by_key(key)
         .ok_or_else(|| GpuError::NoAdapter {
-            seen: rejection_report(&rejected, options),
+            seen: rejection_report(&rejected, options, surface),
         })
+}
+
+/// Why `adapter` is not used, or None when it may be.
+fn rejection(
+    adapter: &wgpu::Adapter,
+    options: &GpuOptions,
+    surface: Option<&wgpu::Surface<'_>>,
+) -> Option<String> {
+    let wanted = options.adapter_substring.as_deref().map(str::to_lowercase);
+    if let Some(text) = wanted.filter(|t| !adapter.get_info().name.to_lowercase().contains(t)) {
+        return Some(format!("name does not contain {text:?}"));
+    }
+    surface
+        .filter(|surface| !adapter.is_surface_supported(surface))
+        .map(|_| "it cannot present to the window".to_string())
 }
 
 /// Sort key of an adapter: device type first, then native APIs before GL. Lower is better.
@@ -318,21 +400,22 @@ fn rank(device_type: wgpu::DeviceType, backend: wgpu::Backend) -> (u8, u8) {
     (type_rank, u8::from(backend == wgpu::Backend::Gl))
 }
 
-fn rejection_report(rejected: &[wgpu::Adapter], options: &GpuOptions) -> String {
+fn rejection_report(
+    rejected: &[wgpu::Adapter],
+    options: &GpuOptions,
+    surface: Option<&wgpu::Surface<'_>>,
+) -> String {
     let backends = options
         .backend
         .map_or("vulkan, gl, metal or dx12".to_string(), |b| b.to_string());
     if rejected.is_empty() {
         return format!("no adapter found on backend {backends}");
     }
-    let wanted = options.adapter_substring.as_deref().unwrap_or_default();
     let lines: Vec<String> = rejected
         .iter()
         .map(|adapter| {
-            format!(
-                "{} rejected: name does not contain {wanted:?}",
-                describe(&adapter.get_info())
-            )
+            let why = rejection(adapter, options, surface).unwrap_or_default();
+            format!("{} rejected: {why}", describe(&adapter.get_info()))
         })
         .collect();
     format!("adapters seen on backend {backends}: {}", lines.join("; "))
@@ -383,7 +466,7 @@ mod tests {
             adapter_substring: None,
         };
         let message = GpuError::NoAdapter {
-            seen: rejection_report(&[], &options),
+            seen: rejection_report(&[], &options, None),
         }
         .to_string();
         assert!(message.contains("no adapter found on backend metal"));

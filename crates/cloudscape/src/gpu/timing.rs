@@ -2,13 +2,18 @@
 //!
 //! Use per frame: [`PassTimer::reset`], then [`PassTimer::compute_pass_writes`] for each pass to
 //! time (pass the result to [`wgpu::ComputePassDescriptor::timestamp_writes`]), then
-//! [`PassTimer::resolve`] on the frame's last encoder, submit, and [`PassTimer::read_ms`].
+//! [`PassTimer::resolve`] on the frame's last encoder, submit, and [`PassTimer::read_ms`] (which
+//! waits). A real-time host calls [`PassTimer::resolve_late`] instead and reads the newest finished
+//! frame's times with [`PassTimer::latest_ms`], which never waits.
 //!
 //! On adapters without [`wgpu::Features::TIMESTAMP_QUERY`] (e.g. GL) nothing is timed and
 //! [`PassTimer::read_ms`] returns an empty list. On software adapters (lavapipe, llvmpipe) the
 //! numbers are the CPU time of the emulated GPU work: use them to compare passes with each other,
 //! not as a GPU budget, and never in an assertion.
 
+use std::collections::VecDeque;
+
+use super::late_readback::LateReadback;
 use super::{GpuContext, readback};
 
 /// Bytes of one resolved timestamp.
@@ -28,11 +33,15 @@ struct Queries {
     set: wgpu::QuerySet,
     /// Where [`PassTimer::resolve`] writes the raw ticks; read back with [`readback::read_buffer`].
     resolved: wgpu::Buffer,
+    /// Copies of the ticks read a frame late, and the labels of each frame copied, oldest first.
+    late: LateReadback,
+    late_labels: VecDeque<(u64, Vec<String>)>,
 }
 
 impl PassTimer {
     /// A timer for up to `capacity_passes` passes per frame.
     pub fn new(ctx: &GpuContext, capacity_passes: u32) -> PassTimer {
+        let bytes = 2 * u64::from(capacity_passes) * TIMESTAMP_BYTES;
         let queries = (ctx.has_timestamps() && capacity_passes > 0).then(|| Queries {
             set: ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("pass timer queries"),
@@ -41,10 +50,12 @@ impl PassTimer {
             }),
             resolved: ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("pass timer resolved ticks"),
-                size: 2 * u64::from(capacity_passes) * TIMESTAMP_BYTES,
+                size: bytes,
                 usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
+            late: LateReadback::new(ctx, "pass timer ticks", bytes),
+            late_labels: VecDeque::new(),
         });
         PassTimer {
             queries,
@@ -106,6 +117,34 @@ impl PassTimer {
         }
     }
 
+    /// Like [`PassTimer::resolve`], and copies the ticks out to be read without waiting by
+    /// [`PassTimer::latest_ms`] once the GPU has run the frame.
+    pub fn resolve_late(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        self.resolve(encoder);
+        let Some(queries) = self.queries.as_mut().filter(|_| !self.labels.is_empty()) else {
+            return;
+        };
+        if let Some(frame) = queries.late.copy(encoder, &queries.resolved) {
+            let labels = &mut queries.late_labels;
+            labels.push_back((frame, self.labels.clone()));
+            // The readback holds a few frames in flight; older labels can no longer be read.
+            while labels.len() > 8 {
+                labels.pop_front();
+            }
+        }
+    }
+
+    /// Milliseconds each pass took in the newest frame resolved by [`PassTimer::resolve_late`]
+    /// that the GPU has finished; never waits. None before the first is ready, and without
+    /// timestamp queries.
+    pub fn latest_ms(&mut self, ctx: &GpuContext) -> Option<Vec<(String, f64)>> {
+        let queries = self.queries.as_mut()?;
+        let (frame, bytes) = queries.late.latest_numbered(ctx)?;
+        let (_, labels) = queries.late_labels.iter().find(|(f, _)| *f == frame)?;
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(bytes);
+        Some(pass_times(ctx, labels, &ticks))
+    }
+
     /// Milliseconds each pass of this frame took, in the order the passes were added.
     ///
     /// Call after the encoder holding [`PassTimer::resolve`] was submitted; blocks until it ran.
@@ -118,16 +157,21 @@ impl PassTimer {
             return Vec::new();
         }
         let ticks: Vec<u64> = readback::read_buffer(ctx, &queries.resolved);
-        let ns_per_tick = f64::from(ctx.queue.get_timestamp_period());
-        self.labels
-            .iter()
-            .zip(ticks.chunks_exact(2))
-            .map(|(label, pair)| {
-                let elapsed_ticks = pair[1].saturating_sub(pair[0]);
-                (label.clone(), elapsed_ticks as f64 * ns_per_tick * 1e-6)
-            })
-            .collect()
+        pass_times(ctx, &self.labels, &ticks)
     }
+}
+
+/// Each label with the milliseconds between its pair of `ticks` (start, end).
+fn pass_times(ctx: &GpuContext, labels: &[String], ticks: &[u64]) -> Vec<(String, f64)> {
+    let ns_per_tick = f64::from(ctx.queue.get_timestamp_period());
+    labels
+        .iter()
+        .zip(ticks.chunks_exact(2))
+        .map(|(label, pair)| {
+            let elapsed_ticks = pair[1].saturating_sub(pair[0]);
+            (label.clone(), elapsed_ticks as f64 * ns_per_tick * 1e-6)
+        })
+        .collect()
 }
 
 /// The writes of query pair `index`: its beginning and end timestamps.

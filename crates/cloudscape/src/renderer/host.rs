@@ -8,7 +8,9 @@
 
 use super::dispatch;
 use crate::environment::{Environment, EnvironmentGpu, EnvironmentPasses, EnvironmentUniform};
-use crate::field::gpu::{FieldGpu, FieldUpdate};
+pub use crate::field::gpu::FieldUpdate;
+
+use crate::field::gpu::FieldGpu;
 use crate::field::{CloudField, FieldError};
 use crate::frame::{Frame, FrameGpu, Shared};
 use crate::gpu::pipeline::{STORAGE_OUTPUT, texture_2d};
@@ -17,7 +19,7 @@ use crate::output::{CloudOutput, SampleGrid};
 use crate::post::upsample::Upsampler;
 use crate::post::{Background, Compositor, DISPLAY_FORMAT, Display, HDR_FORMAT};
 use crate::scene::Scene;
-use crate::shadow::ShadowParams;
+use crate::shadow::{BuiltShadow, ShadowParams, ShadowReuse};
 use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use crate::temporal::{TemporalResolve, TemporalSettings};
 use glam::{UVec2, Vec2};
@@ -72,6 +74,20 @@ impl Targets {
     }
 }
 
+/// Whether going from scene `previous` to `next` needs [`CloudRenderer::update_scene`]: a change of
+/// the cloud field (layers, weather, noise, volumes, planet), of the technique, or of the sprite
+/// technique's clouds. Every frame reads the rest (camera, sun, sky, shadow map, ground, phase
+/// function, lighting, particle settings, steps, exposure, tone mapping, time).
+pub fn needs_update(previous: &Scene, next: &Scene) -> bool {
+    fn rebuilt(s: &Scene) -> impl PartialEq + '_ {
+        (
+            (&s.layers, &s.weather, &s.noise, &s.volumes, &s.planet),
+            (s.render.technique, &s.sprites, &s.sprite_clouds),
+        )
+    }
+    rebuilt(previous) != rebuilt(next)
+}
+
 /// Clouds for a host renderer: the field, the shared frame state, the scene's technique and the
 /// shared passes, made once.
 pub struct CloudRenderer {
@@ -90,6 +106,11 @@ pub struct CloudRenderer {
     targets: Option<Targets>,
     frame: Option<Frame>,
     reuse: Reuse,
+    /// Whether the shadow map may be kept across frames, what the current one was built for, and
+    /// whether this frame builds it.
+    shadow_reuse: Option<ShadowReuse>,
+    shadow_built: Option<BuiltShadow>,
+    shadow_rebuild: bool,
 }
 
 impl CloudRenderer {
@@ -128,6 +149,9 @@ impl CloudRenderer {
             targets: None,
             frame: None,
             reuse: Reuse::None,
+            shadow_reuse: None,
+            shadow_built: None,
+            shadow_rebuild: true,
         })
     }
 
@@ -148,8 +172,25 @@ impl CloudRenderer {
         if sprites || self.technique.name() != scene.render.technique.name() {
             self.technique = dispatch::build(ctx, &self.shared(), scene, base_dir)?;
         }
+        self.shadow_built = None;
         self.reset_history();
         Ok(update)
+    }
+
+    /// Takes a live edit from `previous` to `scene` and rebuilds only what depends on it: calls
+    /// [`CloudRenderer::update_scene`] when [`needs_update`] says so (returning what it did), and
+    /// nothing otherwise, as every frame reads the rest.
+    pub fn apply_edit(
+        &mut self,
+        ctx: &GpuContext,
+        previous: &Scene,
+        scene: &Scene,
+        base_dir: &Path,
+    ) -> Result<Option<FieldUpdate>, FieldError> {
+        if !needs_update(previous, scene) {
+            return Ok(None);
+        }
+        self.update_scene(ctx, scene, base_dir).map(Some)
     }
 
     /// The CPU field drawn (the specification the GPU follows).
@@ -235,7 +276,7 @@ impl CloudRenderer {
         self.frame_gpu.write(ctx, &frame.uniform(&grid));
         let env = Environment::from_scene(scene);
         let viewpoint = frame.camera_position_m;
-        let shadow = ShadowParams::new(scene, &self.field, viewpoint, env.sun.direction);
+        let shadow = self.frame_shadow(scene, &env, frame);
         self.environment_gpu
             .resize_shadow_map(ctx, scene.shadow.resolution);
         let uniform = EnvironmentUniform::new(&env, viewpoint, &shadow);
@@ -250,6 +291,41 @@ impl CloudRenderer {
         self.technique.prepare(ctx, &inputs);
         self.frame = Some(frame.clone());
         self.reuse = reuse;
+    }
+
+    /// The shadow map this frame reads: the one built before, when [`ShadowReuse`] allows it,
+    /// else a new one (and the frame's environment passes build it).
+    fn frame_shadow(&mut self, scene: &Scene, env: &Environment, frame: &Frame) -> ShadowParams {
+        let sun = env.sun.direction;
+        let fresh = BuiltShadow {
+            params: ShadowParams::new(scene, &self.field, frame.camera_position_m, sun),
+            sun,
+            texels: scene.shadow.resolution,
+            time_s: frame.time_s,
+        };
+        let wind = self.wind_m_per_s();
+        let kept = match (self.shadow_reuse, &self.shadow_built) {
+            (Some(reuse), Some(built)) if built.serves(&fresh, wind, reuse) => Some(*built),
+            _ => None,
+        };
+        self.shadow_rebuild = kept.is_none();
+        let used = kept.unwrap_or(fresh);
+        self.shadow_built = Some(used);
+        used.params
+    }
+
+    /// The wind of the first layer, which carries the clouds (zero without layers).
+    fn wind_m_per_s(&self) -> Vec2 {
+        self.field
+            .layers
+            .first()
+            .map_or(Vec2::ZERO, |l| l.wind_m_per_s)
+    }
+
+    /// Lets the clouds' shadow map be reused across frames (see [`ShadowReuse`]), or, with None,
+    /// rebuilt every frame (the default, as offline renders need).
+    pub fn set_shadow_reuse(&mut self, reuse: Option<ShadowReuse>) {
+        self.shadow_reuse = reuse;
     }
 
     /// Records the technique over output texels `region` (origin, size; None for all of them),
@@ -301,7 +377,7 @@ impl CloudRenderer {
             environment: &self.environment_gpu,
         };
         self.environment_passes
-            .encode(ctx, encoder, &shared, env, timer);
+            .encode(ctx, encoder, &shared, (env, self.shadow_rebuild), timer);
         *pending = false;
     }
 
@@ -326,13 +402,9 @@ impl CloudRenderer {
             .targets
             .as_ref()
             .expect("begin_frame makes the targets");
+        let wind = self.wind_m_per_s();
         let clouds = match (self.reuse, self.temporal.as_mut()) {
             (Reuse::Temporal(_), Some(temporal)) => {
-                let wind = self
-                    .field
-                    .layers
-                    .first()
-                    .map_or(Vec2::ZERO, |l| l.wind_m_per_s);
                 let inputs = (&t.output, background.depth);
                 let timer = timer.as_deref_mut();
                 temporal.encode(ctx, encoder, &shared, (frame, wind), inputs, timer)
@@ -388,5 +460,33 @@ impl CloudRenderer {
         if let Some(t) = self.temporal.as_mut() {
             t.reset();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_the_field_the_technique_and_sprite_clouds_need_an_update() {
+        let base = Scene::default();
+        let changed = |edit: fn(&mut Scene)| {
+            let mut next = base.clone();
+            edit(&mut next);
+            needs_update(&base, &next)
+        };
+        assert!(changed(|s| s.layers[0].coverage = 0.7));
+        assert!(changed(|s| s.noise.seed = 9));
+        assert!(changed(|s| s.planet.radius_m = 1.0e6));
+        assert!(changed(
+            |s| s.render.technique = crate::scene::Technique::Sprites
+        ));
+        assert!(changed(|s| s.sprites.cloud_size_m = 900.0));
+        assert!(!changed(|s| s.sun.elevation_deg = 5.0));
+        assert!(!changed(|s| s.lighting.ambient_scale = 2.0));
+        assert!(!changed(|s| s.render.quality = crate::scene::Quality::Low));
+        assert!(!changed(|s| s.render.exposure_ev = 1.0));
+        assert!(!changed(|s| s.camera.position_m[1] = 900.0));
+        assert!(!changed(|s| s.particles.radius_m = 300.0));
     }
 }

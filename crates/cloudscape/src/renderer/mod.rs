@@ -5,7 +5,7 @@
 mod dispatch;
 mod host;
 
-pub use host::{CloudRenderer, FrameImages, Reuse};
+pub use host::{CloudRenderer, FieldUpdate, FrameImages, Reuse, needs_update};
 
 use crate::field::{CloudField, FieldError};
 use crate::frame::Frame;
@@ -35,8 +35,9 @@ pub struct Rendered {
     pub ldr: LdrImage,
 }
 
-/// An offline host's empty scene: a depth buffer with no geometry and a colour never shown.
-struct EmptyHost {
+/// An offline host's empty scene: a depth buffer with no geometry and a colour never shown, for a
+/// host that draws only the clouds and the built-in sky, sun and ground.
+pub struct EmptyHost {
     size: UVec2,
     convention: crate::frame::DepthConvention,
     depth: wgpu::TextureView,
@@ -44,7 +45,9 @@ struct EmptyHost {
 }
 
 impl EmptyHost {
-    fn new(ctx: &GpuContext, size: UVec2, frame: &Frame) -> EmptyHost {
+    /// The empty scene of `frame`: its size and depth convention, the depth cleared to far.
+    pub fn new(ctx: &GpuContext, frame: &Frame) -> EmptyHost {
+        let size = frame.size;
         use wgpu::TextureUsages as U;
         let usage = U::TEXTURE_BINDING | U::RENDER_ATTACHMENT;
         let depth = texture_2d(ctx, "depth", size, wgpu::TextureFormat::Depth32Float, usage)
@@ -62,7 +65,18 @@ impl EmptyHost {
         }
     }
 
-    fn background(&self) -> Background<'_> {
+    /// Whether this is the empty scene of `frame` (same size and depth convention).
+    pub fn fits(&self, frame: &Frame) -> bool {
+        self.size == frame.size && self.convention == frame.depth
+    }
+
+    /// The depth buffer, for [`CloudRenderer::encode_clouds`].
+    pub fn depth(&self) -> &wgpu::TextureView {
+        &self.depth
+    }
+
+    /// The background, for [`CloudRenderer::encode_finish`].
+    pub fn background(&self) -> Background<'_> {
         Background {
             color: &self.color,
             depth: &self.depth,
@@ -112,12 +126,8 @@ impl SceneRenderer {
     }
 
     fn host(&mut self, ctx: &GpuContext, frame: &Frame) -> &EmptyHost {
-        if self
-            .host
-            .as_ref()
-            .is_none_or(|h| h.size != frame.size || h.convention != frame.depth)
-        {
-            self.host = Some(EmptyHost::new(ctx, frame.size, frame));
+        if self.host.as_ref().is_none_or(|h| !h.fits(frame)) {
+            self.host = Some(EmptyHost::new(ctx, frame));
         }
         self.host.as_ref().expect("the host was just made")
     }
@@ -191,19 +201,23 @@ impl SceneRenderer {
 
     /// The images of the last frame rendered (waits for it).
     pub fn images(&self, ctx: &GpuContext) -> Rendered {
-        let images = self.clouds.images();
-        let (width, height) = (images.hdr.width(), images.hdr.height());
-        let hdr = HdrImage {
-            width,
-            height,
-            pixels: readback::read_texture_rgba16f(ctx, images.hdr),
-        };
-        let bytes = readback::read_texture(ctx, images.ldr);
-        let ldr = LdrImage {
-            width,
-            height,
-            pixels: bytemuck::cast_slice(&bytes).to_vec(),
-        };
-        Rendered { hdr, ldr }
+        read_back(ctx, &self.clouds.images())
     }
+}
+
+/// Reads a frame's composed HDR and tone-mapped images back (waits for the GPU).
+pub fn read_back(ctx: &GpuContext, images: &FrameImages) -> Rendered {
+    let (width, height) = (images.hdr.width(), images.hdr.height());
+    let hdr = HdrImage {
+        width,
+        height,
+        pixels: readback::read_texture_rgba16f(ctx, images.hdr),
+    };
+    let bytes = readback::read_texture(ctx, images.ldr);
+    let ldr = LdrImage {
+        width,
+        height,
+        pixels: bytemuck::cast_slice(&bytes).to_vec(),
+    };
+    Rendered { hdr, ldr }
 }

@@ -8,11 +8,13 @@
 mod derive;
 mod error;
 mod key_path;
+pub mod knobs;
 mod load;
 mod locate;
 pub mod metar;
 mod model;
 mod overrides;
+mod save;
 mod source_map;
 mod validate;
 

@@ -7,10 +7,11 @@
 //! Radiometry: radiance and irradiance share one relative radiometric unit (think W m^-2 sr^-1 and
 //! W m^-2, scaled); only ratios matter, and exposure maps them to the display.
 
+use documented::{DocumentedFields, DocumentedVariants};
 use serde::{Deserialize, Serialize};
 
 /// A whole scene: camera, light, sky, ground, planet, clouds and render settings.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct Scene {
     /// Where the eye is and where it looks.
@@ -76,7 +77,7 @@ impl Default for Scene {
 }
 
 /// A pinhole camera.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct Camera {
     /// Eye position in metres (`y` is altitude above the ground under the origin).
@@ -110,7 +111,7 @@ impl Default for Camera {
 }
 
 /// The sun, a distant disc light.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct Sun {
     /// Elevation above the horizon in degrees, -90..90.
@@ -132,7 +133,7 @@ pub struct Sun {
 
 /// A moment and a place on Earth, which put the sun on the sky (see
 /// [`crate::animation::solar_position`]).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields)]
 pub struct TimeOfDay {
     /// Local solar time in hours, 0..24: 12 is solar noon, when the sun crosses the meridian.
@@ -157,7 +158,7 @@ impl Default for Sun {
 }
 
 /// How sky radiance varies with direction.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, DocumentedVariants)]
 #[serde(rename_all = "snake_case")]
 pub enum SkyModel {
     /// The same radiance (`sky.radiance`) in every direction.
@@ -170,7 +171,7 @@ pub enum SkyModel {
 }
 
 /// Sky light: the physically based atmosphere, or its simple analytic stand-ins.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct Sky {
     /// Which sky model to use.
@@ -205,7 +206,7 @@ impl Default for Sky {
 /// The clouds' shared shadow map (light-space transmittance), built from the coarse field each
 /// frame: it shades the ground, the air's light shafts and a host's geometry. It reaches the
 /// camera's far distance around the viewpoint.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct Shadow {
     /// Texels per side of the map, 16..4096.
@@ -228,7 +229,7 @@ impl Default for Shadow {
 }
 
 /// The ground: a Lambertian surface lit by the sun and the sky.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct Ground {
     /// Whether there is a ground at all; without one, rays below the horizon see the sky.
@@ -247,7 +248,7 @@ impl Default for Ground {
 }
 
 /// The planet's shape.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, DocumentedVariants)]
 #[serde(rename_all = "snake_case")]
 pub enum PlanetShape {
     /// A sphere of `radius_m`: layers follow its curvature and sink below the horizon.
@@ -257,7 +258,7 @@ pub enum PlanetShape {
 }
 
 /// The planet under the clouds.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct Planet {
     /// Spherical or flat.
@@ -277,7 +278,7 @@ impl Default for Planet {
 
 /// Relative amounts of the four canonical cloud types in a layer; at least one must be positive.
 /// The weather map's type channel picks among them (see [`crate::field`]).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct CloudTypeMix {
     /// Weight of stratus: a thin flat sheet near the layer bottom, >= 0.
@@ -310,7 +311,7 @@ fn cumulus_only() -> CloudTypeMix {
 }
 
 /// One layer of clouds between two altitudes.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct CloudLayer {
     /// Altitude of the layer bottom above the ground, metres, >= 0.
@@ -346,7 +347,7 @@ impl Default for CloudLayer {
 }
 
 /// Where the weather map comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, DocumentedVariants)]
 #[serde(rename_all = "snake_case")]
 pub enum WeatherSource {
     /// Generated from `seed`.
@@ -357,7 +358,7 @@ pub enum WeatherSource {
 
 /// The 2D weather map: per position, cloud coverage, cloud type and density. It repeats every
 /// `extent_km` in both directions.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct WeatherMap {
     /// Procedural or from a file.
@@ -392,7 +393,7 @@ impl Default for WeatherMap {
 }
 
 /// The 3D noise that gives clouds their shape (Schneider 2015, Horizon Zero Dawn).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct NoiseSettings {
     /// Seed of the noise textures.
@@ -420,7 +421,7 @@ impl Default for NoiseSettings {
 }
 
 /// A density grid from a file, placed in an axis-aligned box in the world.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct VolumeGrid {
     /// Mitsuba 3 `.vol` file, relative to the scene file.
@@ -449,7 +450,7 @@ impl Default for VolumeGrid {
 }
 
 /// Which phase function scatters light in the cloud.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, DocumentedVariants)]
 #[serde(rename_all = "snake_case")]
 pub enum PhaseModel {
     /// Approximate Mie for water droplets (Jendersie & d'Eon 2023), from `droplet_diameter_um`.
@@ -461,7 +462,7 @@ pub enum PhaseModel {
 }
 
 /// The phase function and its parameters.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhaseFunction {
     /// Which model.
@@ -492,7 +493,7 @@ impl Default for PhaseFunction {
 }
 
 /// Lighting approximations of the real-time techniques (the path tracer needs none of them).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct Lighting {
     /// Single-scattering albedo sigma_s / sigma_t, 0..1; cloud droplets are about 1 (physics.md).
@@ -541,7 +542,7 @@ impl Default for Lighting {
 
 /// How 3D noise shapes the reference particle (Yusov 2014, "Pre-computing optical depth: 3D noise
 /// generation").
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, DocumentedVariants)]
 #[serde(rename_all = "snake_case")]
 pub enum ParticleStyle {
     /// A smooth radial falloff whose density the noise modulates.
@@ -567,7 +568,7 @@ impl ParticleStyle {
 /// once, for this particle, into look-up tables (`cloudscape bake`). Its peak extinction is the
 /// largest `extinction_per_m` of the layers (0.05 m^-1 without layers), its phase function and
 /// albedo those of the scene.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct Particles {
     /// How 3D noise shapes the particle.
@@ -597,7 +598,7 @@ pub struct Particles {
 }
 
 /// How the particle technique blends particles that overlap along a view ray.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, DocumentedVariants)]
 #[serde(rename_all = "snake_case")]
 pub enum ParticleBlending {
     /// Yusov 2014's volume-aware blending: overlapping particles merge as one volume.
@@ -607,7 +608,7 @@ pub enum ParticleBlending {
 }
 
 /// How finely the particle tables are sampled (sizes in `particles::ParticleTableSpec`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, DocumentedVariants)]
 #[serde(rename_all = "snake_case")]
 pub enum TableResolution {
     /// A quarter of the standard entries: quick previews and tests.
@@ -638,7 +639,7 @@ impl Default for Particles {
 /// The sprite-cluster technique (Wang 2003, "Realistic and Fast Cloud Rendering in Computer
 /// Games", Microsoft Flight Simulator): clouds of 5-50 textured sprites, from the cloud field and
 /// from hand-made boxes, with an octagonal ring of impostors for the distance.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct Sprites {
     /// Build sprite clouds from the cloud field's layers (off: only `sprite_clouds` and `model`).
@@ -687,7 +688,7 @@ impl Default for Sprites {
 }
 
 /// How much of each sprite cloud is drawn.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, DocumentedVariants)]
 #[serde(rename_all = "snake_case")]
 pub enum SpriteLod {
     /// Every sprite of every cloud.
@@ -698,7 +699,7 @@ pub enum SpriteLod {
 
 /// A hand-made sprite cloud (Wang 2003, "Cloud creation": an artist builds the shape from boxes,
 /// and a script fills them with sprites). Unset artist parameters come from the type's recipe.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields)]
 pub struct SpriteCloudSpec {
     /// The cloud type: `fair_weather`, `cumulus_humilis`, `cumulus_mediocris`,
@@ -729,7 +730,7 @@ pub struct SpriteCloudSpec {
 }
 
 /// One box of a hand-made sprite cloud.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields)]
 pub struct SpriteBoxSpec {
     /// Centre of the box relative to the cloud's centre, m.
@@ -739,7 +740,7 @@ pub struct SpriteBoxSpec {
 }
 
 /// Which renderer draws the clouds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, DocumentedVariants)]
 #[serde(rename_all = "snake_case")]
 pub enum Technique {
     /// Ray-marched clouds (compute).
@@ -769,7 +770,7 @@ impl Technique {
 }
 
 /// Named sets of step counts, from fast to converged.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, DocumentedVariants)]
 #[serde(rename_all = "snake_case")]
 pub enum Quality {
     /// Real-time budget on a low-end GPU.
@@ -783,7 +784,7 @@ pub enum Quality {
 }
 
 /// Tone-mapping operator from HDR radiance to display values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, DocumentedVariants)]
 #[serde(rename_all = "snake_case")]
 pub enum Tonemap {
     /// ACES filmic fit (Hill's RRT+ODT fit).
@@ -793,7 +794,7 @@ pub enum Tonemap {
 }
 
 /// Image size, technique, quality and output.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct RenderSettings {
     /// Image width in pixels, 1..the adapter's maximum texture size.
@@ -845,7 +846,7 @@ impl Default for RenderSettings {
 /// Changes over scene time, as keyframed paths (see [`crate::animation`]). Each path is either
 /// empty (that part of the scene stays as the rest of the scene says) or holds at least 2 keyframes
 /// with strictly increasing `time_s`. Before its first keyframe and after its last, a path holds.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct Animation {
     /// Camera keyframes: position, and orientation by look-at point or by yaw and pitch.
@@ -867,7 +868,7 @@ impl Animation {
 }
 
 /// One keyframe of the camera path.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields)]
 pub struct CameraKey {
     /// Scene time of the keyframe, seconds; later than the previous keyframe's.
@@ -889,7 +890,7 @@ pub struct CameraKey {
 /// One keyframe of the sun's path over the sky: by elevation and azimuth, or by local solar time
 /// (at the latitude and day of `sun.time_of_day`), one or the other. Between two solar-time
 /// keyframes the sun follows its true course over the sky.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields)]
 pub struct SunKey {
     /// Scene time of the keyframe, seconds; later than the previous keyframe's.
@@ -929,7 +930,7 @@ impl SunKey {
 }
 
 /// One keyframe of the coverage factor.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields)]
 pub struct CoverageKey {
     /// Scene time of the keyframe, seconds; later than the previous keyframe's.

@@ -1,15 +1,13 @@
-//! Range checks of every numeric field, in one table per struct, and the checks between fields.
-//!
-//! The ranges restate the doc comments of [`super::model`]; change both together. Seeds are not
-//! listed: every `u32` is a valid seed.
+//! Range checks of every numeric field, from the knob tables of [`super::knobs`], and the checks
+//! between fields.
 
 use std::fmt;
 
 use crate::animation::key_direction;
 
+use super::knobs::{self, Field, Knob};
 use super::model::{
-    CameraKey, CloudLayer, CoverageKey, Scene, SpriteBoxSpec, SpriteCloudSpec, SunKey, VolumeGrid,
-    WeatherSource,
+    CameraKey, CloudLayer, CoverageKey, Scene, SpriteCloudSpec, SunKey, VolumeGrid, WeatherSource,
 };
 
 /// A value that breaks a rule, by dotted key path.
@@ -23,12 +21,15 @@ pub(super) struct Violation {
 
 /// Checks every field of `scene` and every relation between fields; the first violation found.
 pub(super) fn validate(scene: &Scene) -> Result<(), Violation> {
-    check(scene, "", SCENE_RULES, SCENE_RELATIONS)?;
+    check(scene, "", knobs::SCENE, SCENE_RELATIONS)?;
+    if let Some(time) = &scene.sun.time_of_day {
+        check(time, "sun.time_of_day.", knobs::TIME_OF_DAY, &[])?;
+    }
     for (index, layer) in scene.layers.iter().enumerate() {
         check(
             layer,
             &format!("layers.{index}."),
-            LAYER_RULES,
+            knobs::LAYER,
             LAYER_RELATIONS,
         )?;
     }
@@ -36,7 +37,7 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Violation> {
         check(
             volume,
             &format!("volumes.{index}."),
-            VOLUME_RULES,
+            knobs::VOLUME,
             VOLUME_RELATIONS,
         )?;
     }
@@ -48,12 +49,12 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Violation> {
 fn validate_sprite_clouds(scene: &Scene) -> Result<(), Violation> {
     for (index, cloud) in scene.sprite_clouds.iter().enumerate() {
         let prefix = format!("sprite_clouds.{index}.");
-        check(cloud, &prefix, SPRITE_CLOUD_RULES, SPRITE_CLOUD_RELATIONS)?;
+        check(cloud, &prefix, knobs::SPRITE_CLOUD, SPRITE_CLOUD_RELATIONS)?;
         for (b, sprite_box) in cloud.boxes.iter().enumerate() {
             check(
                 sprite_box,
                 &format!("{prefix}boxes.{b}."),
-                SPRITE_BOX_RULES,
+                knobs::SPRITE_BOX,
                 &[],
             )?;
         }
@@ -78,92 +79,6 @@ fn validate_animation(scene: &Scene) -> Result<(), Violation> {
     )
 }
 
-/// The allowed values of a numeric field; every allowed value is also finite.
-#[derive(Clone, Copy, Debug)]
-enum Allowed {
-    /// Any finite number.
-    Finite,
-    /// `min..=max`.
-    Between(f32, f32),
-    /// `>= min`.
-    AtLeast(f32),
-    /// `> min`.
-    Above(f32),
-}
-
-impl Allowed {
-    fn contains(self, value: f64) -> bool {
-        match self {
-            Allowed::Finite => true,
-            Allowed::Between(min, max) => f64::from(min) <= value && value <= f64::from(max),
-            Allowed::AtLeast(min) => f64::from(min) <= value,
-            Allowed::Above(min) => f64::from(min) < value,
-        }
-    }
-
-    /// The range in words, with its unit: `1..179 deg`, `>= 0`, `any finite number (m)`.
-    fn describe(self, unit: &str) -> String {
-        let range = match self {
-            Allowed::Finite => "any finite number".to_string(),
-            Allowed::Between(min, max) => format!("{min}..{max}"),
-            Allowed::AtLeast(min) => format!(">= {min}"),
-            Allowed::Above(min) => format!("> {min}"),
-        };
-        match (self, unit) {
-            (_, "") => range,
-            (Allowed::Finite, _) => format!("{range} ({unit})"),
-            _ => format!("{range} {unit}"),
-        }
-    }
-}
-
-/// A numeric field as read from the scene.
-enum Field<'a> {
-    Float(f32),
-    Int(u32),
-    /// An array: each element is checked, and named by its index.
-    Floats(&'a [f32]),
-    /// An optional field that is not set.
-    Absent,
-}
-
-fn optional_floats<const N: usize>(value: &Option<[f32; N]>) -> Field<'_> {
-    value.as_ref().map_or(Field::Absent, |v| Field::Floats(v))
-}
-
-fn optional_float(value: Option<f32>) -> Field<'static> {
-    value.map_or(Field::Absent, Field::Float)
-}
-
-fn optional_int(value: Option<u32>) -> Field<'static> {
-    value.map_or(Field::Absent, Field::Int)
-}
-
-/// One row of a table: a field, its allowed values and its unit.
-struct Rule<T> {
-    /// Dotted key path relative to `T`.
-    key: &'static str,
-    allowed: Allowed,
-    /// Unit for messages; empty for dimensionless fields.
-    unit: &'static str,
-    read: fn(&T) -> Field<'_>,
-}
-
-/// Shorthand that keeps each row of the tables on one line.
-const fn rule<T>(
-    key: &'static str,
-    allowed: Allowed,
-    unit: &'static str,
-    read: fn(&T) -> Field<'_>,
-) -> Rule<T> {
-    Rule {
-        key,
-        allowed,
-        unit,
-        read,
-    }
-}
-
 /// A check between fields of `T`; `broken` returns the message when the check fails.
 struct Relation<T> {
     /// Dotted key path (relative to `T`) of the field the message is about.
@@ -180,8 +95,8 @@ struct PairRelation<K> {
 
 /// Everything checked on the keyframes of one path type.
 struct PathRules<K: 'static> {
-    /// Rules of each keyframe's numeric fields.
-    rules: &'static [Rule<K>],
+    /// The knobs of each keyframe.
+    rules: &'static [Knob<K>],
     /// Checks within each keyframe.
     relations: &'static [Relation<K>],
     /// Checks between consecutive keyframes.
@@ -211,111 +126,6 @@ impl Keyframe for CoverageKey {
     }
 }
 
-use Allowed::{Above, AtLeast, Between, Finite};
-use Field::{Float, Floats, Int};
-
-#[rustfmt::skip]
-const SCENE_RULES: &[Rule<Scene>] = &[
-    rule("camera.position_m", Finite, "m", |s| Floats(&s.camera.position_m)),
-    rule("camera.look_at_m", Finite, "m", |s| optional_floats(&s.camera.look_at_m)),
-    rule("camera.yaw_deg", Finite, "deg", |s| Float(s.camera.yaw_deg)),
-    rule("camera.pitch_deg", Between(-90.0, 90.0), "deg", |s| Float(s.camera.pitch_deg)),
-    rule("camera.fov_y_deg", Between(1.0, 179.0), "deg", |s| Float(s.camera.fov_y_deg)),
-    rule("camera.near_m", Above(0.0), "m", |s| Float(s.camera.near_m)),
-    rule("camera.far_m", Above(0.0), "m", |s| Float(s.camera.far_m)),
-    rule("sun.elevation_deg", Between(-90.0, 90.0), "deg", |s| Float(s.sun.elevation_deg)),
-    rule("sun.azimuth_deg", Finite, "deg", |s| Float(s.sun.azimuth_deg)),
-    rule("sun.irradiance", AtLeast(0.0), "", |s| Float(s.sun.irradiance)),
-    rule("sun.color", Between(0.0, 1.0), "", |s| Floats(&s.sun.color)),
-    rule("sun.angular_radius_deg", Between(0.0, 5.0), "deg", |s| Float(s.sun.angular_radius_deg)),
-    rule("sun.time_of_day.solar_time_h", Between(0.0, 24.0), "h", |s| optional_float(s.sun.time_of_day.as_ref().map(|t| t.solar_time_h))),
-    rule("sun.time_of_day.latitude_deg", Between(-90.0, 90.0), "deg", |s| optional_float(s.sun.time_of_day.as_ref().map(|t| t.latitude_deg))),
-    rule("sun.time_of_day.day_of_year", Between(1.0, 366.0), "", |s| optional_int(s.sun.time_of_day.as_ref().map(|t| t.day_of_year))),
-    rule("sky.radiance", AtLeast(0.0), "", |s| Floats(&s.sky.radiance)),
-    rule("sky.zenith_radiance", AtLeast(0.0), "", |s| Floats(&s.sky.zenith_radiance)),
-    rule("sky.horizon_radiance", AtLeast(0.0), "", |s| Floats(&s.sky.horizon_radiance)),
-    rule("sky.gradient_exponent", Between(0.05, 10.0), "", |s| Float(s.sky.gradient_exponent)),
-    rule("sky.visibility_m", Between(100.0, 1.0e7), "m", |s| Float(s.sky.visibility_m)),
-    rule("shadow.resolution", Between(16.0, 4096.0), "texels", |s| Int(s.shadow.resolution)),
-    rule("shadow.steps", Between(4.0, 256.0), "", |s| Int(s.shadow.steps)),
-    rule("shadow.warp", Between(0.05, 1.0), "", |s| Float(s.shadow.warp)),
-    rule("ground.albedo", Between(0.0, 1.0), "", |s| Floats(&s.ground.albedo)),
-    rule("planet.radius_m", Between(1.0e3, 1.0e8), "m", |s| Float(s.planet.radius_m)),
-    rule("weather.extent_km", Between(0.1, 1.0e4), "km", |s| Float(s.weather.extent_km)),
-    rule("weather.resolution", Between(8.0, 4096.0), "texels", |s| Int(s.weather.resolution)),
-    rule("weather.feature_size_km", Above(0.0), "km", |s| Float(s.weather.feature_size_km)),
-    rule("noise.base_period_m", Above(0.0), "m", |s| Float(s.noise.base_period_m)),
-    rule("noise.detail_period_m", Above(0.0), "m", |s| Float(s.noise.detail_period_m)),
-    rule("noise.detail_erosion", Between(0.0, 1.0), "", |s| Float(s.noise.detail_erosion)),
-    rule("noise.curl_displacement_m", AtLeast(0.0), "m", |s| Float(s.noise.curl_displacement_m)),
-    rule("phase.droplet_diameter_um", Between(5.0, 50.0), "um", |s| Float(s.phase.droplet_diameter_um)),
-    rule("phase.g", Between(-0.99, 0.99), "", |s| Float(s.phase.g)),
-    rule("phase.g_forward", Between(-0.99, 0.99), "", |s| Float(s.phase.g_forward)),
-    rule("phase.g_back", Between(-0.99, 0.99), "", |s| Float(s.phase.g_back)),
-    rule("phase.forward_weight", Between(0.0, 1.0), "", |s| Float(s.phase.forward_weight)),
-    rule("lighting.albedo", Between(0.0, 1.0), "", |s| Float(s.lighting.albedo)),
-    rule("lighting.octaves", Between(1.0, 8.0), "", |s| Int(s.lighting.octaves)),
-    rule("lighting.octave_attenuation", Between(0.0, 1.0), "", |s| Float(s.lighting.octave_attenuation)),
-    rule("lighting.octave_contribution", Between(0.0, 1.0), "", |s| Float(s.lighting.octave_contribution)),
-    rule("lighting.octave_eccentricity", Between(0.0, 1.0), "", |s| Float(s.lighting.octave_eccentricity)),
-    rule("lighting.ambient_scale", Between(0.0, 4.0), "", |s| Float(s.lighting.ambient_scale)),
-    rule("particles.radius_m", Between(10.0, 5000.0), "m", |s| Float(s.particles.radius_m)),
-    rule("particles.rings", Between(1.0, 8.0), "", |s| Int(s.particles.rings)),
-    rule("particles.ring_cells", Between(16.0, 512.0), "", |s| Int(s.particles.ring_cells)),
-    rule("particles.cell_layers", Between(0.0, 16.0), "", |s| Int(s.particles.cell_layers)),
-    rule("particles.distance_m", Between(1.0e3, 1.0e6), "m", |s| Float(s.particles.distance_m)),
-    rule("particles.resolution_divisor", Between(1.0, 4.0), "", |s| Int(s.particles.resolution_divisor)),
-    rule("sprites.cloud_size_m", Between(200.0, 20_000.0), "m", |s| Float(s.sprites.cloud_size_m)),
-    rule("sprites.distance_m", Between(1.0e3, 5.0e5), "m", |s| Float(s.sprites.distance_m)),
-    rule("sprites.ring_radius_m", Between(0.0, 2.0e5), "m", |s| Float(s.sprites.ring_radius_m)),
-    rule("sprites.impostor_texels", Between(64.0, 2048.0), "", |s| Int(s.sprites.impostor_texels)),
-    rule("sprites.lock_distance_m", Between(0.0, 5000.0), "m", |s| Float(s.sprites.lock_distance_m)),
-    rule("sprites.ambient_color", AtLeast(0.0), "", |s| optional_floats(&s.sprites.ambient_color)),
-    rule("sprites.directional_color", AtLeast(0.0), "", |s| optional_floats(&s.sprites.directional_color)),
-    rule("render.width", AtLeast(1.0), "px", |s| Int(s.render.width)),
-    rule("render.height", AtLeast(1.0), "px", |s| Int(s.render.height)),
-    rule("render.primary_steps", Between(1.0, 4096.0), "", |s| optional_int(s.render.primary_steps)),
-    rule("render.light_steps", Between(1.0, 64.0), "", |s| optional_int(s.render.light_steps)),
-    rule("render.samples_per_pixel", Between(1.0, 1024.0), "", |s| optional_int(s.render.samples_per_pixel)),
-    rule("render.exposure_ev", Between(-20.0, 20.0), "EV", |s| Float(s.render.exposure_ev)),
-    rule("render.time_s", Finite, "s", |s| Float(s.render.time_s)),
-];
-
-#[rustfmt::skip]
-const LAYER_RULES: &[Rule<CloudLayer>] = &[
-    rule("bottom_m", AtLeast(0.0), "m", |l| Float(l.bottom_m)),
-    rule("thickness_m", Between(10.0, 20_000.0), "m", |l| Float(l.thickness_m)),
-    rule("coverage", Between(0.0, 1.0), "", |l| Float(l.coverage)),
-    rule("extinction_per_m", Between(0.0, 1.0), "m^-1", |l| Float(l.extinction_per_m)),
-    rule("types.stratus", AtLeast(0.0), "", |l| Float(l.types.stratus)),
-    rule("types.stratocumulus", AtLeast(0.0), "", |l| Float(l.types.stratocumulus)),
-    rule("types.cumulus", AtLeast(0.0), "", |l| Float(l.types.cumulus)),
-    rule("types.cumulonimbus", AtLeast(0.0), "", |l| Float(l.types.cumulonimbus)),
-    rule("wind_m_per_s", Finite, "m/s", |l| Floats(&l.wind_m_per_s)),
-];
-
-#[rustfmt::skip]
-const VOLUME_RULES: &[Rule<VolumeGrid>] = &[
-    rule("center_m", Finite, "m", |v| Floats(&v.center_m)),
-    rule("size_m", Above(0.0), "m", |v| Floats(&v.size_m)),
-    rule("extinction_per_m", Between(0.0, 10.0), "m^-1", |v| Float(v.extinction_per_m)),
-];
-
-#[rustfmt::skip]
-const SPRITE_CLOUD_RULES: &[Rule<SpriteCloudSpec>] = &[
-    rule("center_m", Finite, "m", |c| Floats(&c.center_m)),
-    rule("sprites", Between(1.0, 1000.0), "", |c| optional_int(c.sprites)),
-    rule("width", Between(0.01, 10.0), "", |c| optional_floats(&c.width)),
-    rule("rotation_deg", Between(-180.0, 180.0), "deg", |c| optional_floats(&c.rotation_deg)),
-    rule("color_levels", Between(0.0, 4.0), "", |c| Floats(c.color_levels.as_deref().map_or(&[], |l| l.as_flattened()))),
-];
-
-#[rustfmt::skip]
-const SPRITE_BOX_RULES: &[Rule<SpriteBoxSpec>] = &[
-    rule("center_m", Finite, "m", |b| Floats(&b.center_m)),
-    rule("size_m", Above(0.0), "m", |b| Floats(&b.size_m)),
-];
-
 #[rustfmt::skip]
 const SPRITE_CLOUD_RELATIONS: &[Relation<SpriteCloudSpec>] = &[
     Relation { key: "boxes", broken: no_boxes },
@@ -324,31 +134,8 @@ const SPRITE_CLOUD_RELATIONS: &[Relation<SpriteCloudSpec>] = &[
 ];
 
 #[rustfmt::skip]
-const CAMERA_KEY_RULES: &[Rule<CameraKey>] = &[
-    rule("time_s", Finite, "s", |k| Float(k.time_s)),
-    rule("position_m", Finite, "m", |k| Floats(&k.position_m)),
-    rule("look_at_m", Finite, "m", |k| optional_floats(&k.look_at_m)),
-    rule("yaw_deg", Finite, "deg", |k| Float(k.yaw_deg)),
-    rule("pitch_deg", Between(-90.0, 90.0), "deg", |k| Float(k.pitch_deg)),
-];
-
-#[rustfmt::skip]
-const SUN_KEY_RULES: &[Rule<SunKey>] = &[
-    rule("time_s", Finite, "s", |k| Float(k.time_s)),
-    rule("sun_elevation_deg", Between(-90.0, 90.0), "deg", |k| optional_float(k.sun_elevation_deg)),
-    rule("sun_azimuth_deg", Finite, "deg", |k| optional_float(k.sun_azimuth_deg)),
-    rule("solar_time_h", Between(0.0, 24.0), "h", |k| optional_float(k.solar_time_h)),
-];
-
-#[rustfmt::skip]
-const COVERAGE_KEY_RULES: &[Rule<CoverageKey>] = &[
-    rule("time_s", Finite, "s", |k| Float(k.time_s)),
-    rule("scale", AtLeast(0.0), "", |k| Float(k.scale)),
-];
-
-#[rustfmt::skip]
 const CAMERA_PATH: PathRules<CameraKey> = PathRules {
-    rules: CAMERA_KEY_RULES,
+    rules: knobs::CAMERA_KEY,
     relations: &[Relation { key: "look_at_m", broken: key_looks_at_its_eye }],
     pairs: &[
         PairRelation { key: "time_s", broken: time_not_increasing },
@@ -358,7 +145,7 @@ const CAMERA_PATH: PathRules<CameraKey> = PathRules {
 
 #[rustfmt::skip]
 const SUN_PATH: PathRules<SunKey> = PathRules {
-    rules: SUN_KEY_RULES,
+    rules: knobs::SUN_KEY,
     relations: &[
         Relation { key: "solar_time_h", broken: sun_key_given_both_ways },
         Relation { key: "sun_azimuth_deg", broken: sun_key_has_one_angle },
@@ -369,7 +156,7 @@ const SUN_PATH: PathRules<SunKey> = PathRules {
 
 #[rustfmt::skip]
 const COVERAGE_PATH: PathRules<CoverageKey> = PathRules {
-    rules: COVERAGE_KEY_RULES,
+    rules: knobs::COVERAGE_KEY,
     relations: &[],
     pairs: &[PairRelation { key: "time_s", broken: time_not_increasing }],
 };
@@ -618,15 +405,15 @@ fn check_path<K: Keyframe>(keys: &[K], path: &str, rules: &PathRules<K>) -> Resu
     Ok(())
 }
 
-/// Runs the rules, then the relations, of one item whose keys start with `prefix`.
+/// Checks the knobs, then the relations, of one item whose keys start with `prefix`.
 fn check<T>(
     item: &T,
     prefix: &str,
-    rules: &[Rule<T>],
+    knobs: &[Knob<T>],
     relations: &[Relation<T>],
 ) -> Result<(), Violation> {
-    for rule in rules {
-        rule.check(item, prefix)?;
+    for knob in knobs {
+        check_knob(knob, item, prefix)?;
     }
     for relation in relations {
         if let Some(message) = (relation.broken)(item) {
@@ -639,46 +426,46 @@ fn check<T>(
     Ok(())
 }
 
-impl<T> Rule<T> {
-    fn check(&self, item: &T, prefix: &str) -> Result<(), Violation> {
-        let key = format!("{prefix}{}", self.key);
-        match (self.read)(item) {
-            Field::Float(value) => self.check_number(key, f64::from(value), &value),
-            Field::Int(value) => self.check_number(key, f64::from(value), &value),
-            Field::Floats(values) => values.iter().enumerate().try_for_each(|(index, value)| {
-                self.check_number(format!("{key}.{index}"), f64::from(*value), value)
-            }),
-            Field::Absent => Ok(()),
-        }
+/// Checks that every number `knob` reads from `item` is allowed.
+fn check_knob<T>(knob: &Knob<T>, item: &T, prefix: &str) -> Result<(), Violation> {
+    let key = format!("{prefix}{}", knob.key);
+    match knob.get(item) {
+        Field::Float(value) => check_number(knob, key, f64::from(value), &value),
+        Field::Int(value) => check_number(knob, key, f64::from(value), &value),
+        Field::Floats(values) => values.iter().enumerate().try_for_each(|(index, value)| {
+            check_number(knob, format!("{key}.{index}"), f64::from(*value), value)
+        }),
+        Field::Bool(_) | Field::Choice(_) | Field::Absent => Ok(()),
     }
+}
 
-    fn check_number(
-        &self,
-        key: String,
-        value: f64,
-        shown: &dyn fmt::Display,
-    ) -> Result<(), Violation> {
-        let problem = if !value.is_finite() {
-            "is not a finite number"
-        } else if !self.allowed.contains(value) {
-            "is out of range"
-        } else {
-            return Ok(());
-        };
-        Err(Violation {
-            key,
-            message: format!(
-                "{shown} {problem}; allowed {}",
-                self.allowed.describe(self.unit)
-            ),
-        })
-    }
+/// Checks one number `value` (displayed as `shown`) against `knob`'s range.
+fn check_number<T>(
+    knob: &Knob<T>,
+    key: String,
+    value: f64,
+    shown: &dyn fmt::Display,
+) -> Result<(), Violation> {
+    let problem = if !value.is_finite() {
+        "is not a finite number"
+    } else if !knob.allowed.contains(value) {
+        "is out of range"
+    } else {
+        return Ok(());
+    };
+    Err(Violation {
+        key,
+        message: format!(
+            "{shown} {problem}; allowed {}",
+            knob.allowed.describe(knob.unit)
+        ),
+    })
 }
 
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
-    use crate::scene::model::{Animation, TimeOfDay, VolumeGrid};
+    use crate::scene::model::{Animation, SpriteBoxSpec, TimeOfDay, VolumeGrid};
 
     /// Two camera keyframes 10 s apart that look at a point, two sun and two coverage keyframes.
     pub(in crate::scene) fn two_key_animation() -> Animation {
@@ -746,52 +533,87 @@ pub(super) mod tests {
         scene
     }
 
-    /// Dotted paths of the numeric leaves of a TOML value; array-of-table indices are left out.
-    fn numeric_keys(value: &toml::Value, prefix: &str, out: &mut Vec<String>) {
-        match value {
-            toml::Value::Table(table) => {
-                for (key, child) in table {
-                    numeric_keys(child, &format!("{prefix}{key}."), out);
-                }
-            }
-            toml::Value::Array(items) if items.iter().all(toml::Value::is_table) => {
-                items
-                    .iter()
-                    .for_each(|item| numeric_keys(item, prefix, out));
-            }
-            toml::Value::Array(_) | toml::Value::Integer(_) | toml::Value::Float(_) => {
-                out.push(prefix.trim_end_matches('.').to_string());
-            }
-            _ => {}
-        }
+    /// What a leaf of a scene file holds.
+    #[derive(Clone, Copy, PartialEq, Debug)]
+    enum Leaf {
+        /// A number or an array of numbers.
+        Numeric,
+        /// True or false.
+        Bool,
+        /// A string: a name from a list or free text.
+        Text,
     }
 
-    /// The keys of `rules`, each after `prefix`.
-    fn prefixed<T>(prefix: &str, rules: &[Rule<T>]) -> Vec<String> {
-        rules.iter().map(|r| format!("{prefix}{}", r.key)).collect()
+    /// Dotted paths of the leaves of a TOML value, by kind; array-of-table indices are left out.
+    fn leaves(value: &toml::Value, prefix: &str, out: &mut Vec<(String, Leaf)>) {
+        let kind = match value {
+            toml::Value::Table(table) => {
+                for (key, child) in table {
+                    leaves(child, &format!("{prefix}{key}."), out);
+                }
+                return;
+            }
+            toml::Value::Array(items) if items.iter().all(toml::Value::is_table) => {
+                items.iter().for_each(|item| leaves(item, prefix, out));
+                return;
+            }
+            toml::Value::Boolean(_) => Leaf::Bool,
+            toml::Value::String(_) => Leaf::Text,
+            _ => Leaf::Numeric,
+        };
+        out.push((prefix.trim_end_matches('.').to_string(), kind));
+    }
+
+    /// The keys of `knobs`, each after `prefix`, with whether each holds a number.
+    fn prefixed<T>(prefix: &str, knobs: &[Knob<T>]) -> Vec<(String, bool)> {
+        let numeric = |k: &Knob<T>| k.allowed != knobs::Allowed::Listed;
+        knobs
+            .iter()
+            .map(|k| (format!("{prefix}{}", k.key), numeric(k)))
+            .collect()
     }
 
     #[test]
-    fn every_numeric_field_except_seeds_has_exactly_one_rule() {
+    fn every_number_switch_and_choice_has_exactly_one_knob() {
         let serialized = toml::Value::try_from(fully_populated()).unwrap();
         let mut fields = Vec::new();
-        numeric_keys(&serialized, "", &mut fields);
-        fields.retain(|key| !key.ends_with("seed"));
-        fields.sort();
+        leaves(&serialized, "", &mut fields);
+        fields.sort_by(|a, b| a.0.cmp(&b.0));
         fields.dedup();
-        let mut ruled: Vec<String> = [
-            prefixed("", SCENE_RULES),
-            prefixed("layers.", LAYER_RULES),
-            prefixed("volumes.", VOLUME_RULES),
-            prefixed("sprite_clouds.", SPRITE_CLOUD_RULES),
-            prefixed("sprite_clouds.boxes.", SPRITE_BOX_RULES),
-            prefixed("animation.camera_path.", CAMERA_KEY_RULES),
-            prefixed("animation.time_of_day.", SUN_KEY_RULES),
-            prefixed("animation.coverage_scale.", COVERAGE_KEY_RULES),
+        let mut knobbed: Vec<(String, bool)> = [
+            prefixed("", knobs::SCENE),
+            prefixed("sun.time_of_day.", knobs::TIME_OF_DAY),
+            prefixed("layers.", knobs::LAYER),
+            prefixed("volumes.", knobs::VOLUME),
+            prefixed("sprite_clouds.", knobs::SPRITE_CLOUD),
+            prefixed("sprite_clouds.boxes.", knobs::SPRITE_BOX),
+            prefixed("animation.camera_path.", knobs::CAMERA_KEY),
+            prefixed("animation.time_of_day.", knobs::SUN_KEY),
+            prefixed("animation.coverage_scale.", knobs::COVERAGE_KEY),
         ]
         .concat();
-        ruled.sort();
-        assert_eq!(ruled, fields);
+        knobbed.sort();
+        let numbers = |leaf: Leaf| leaf == Leaf::Numeric;
+        let numeric: Vec<&String> = fields
+            .iter()
+            .filter(|f| numbers(f.1))
+            .map(|f| &f.0)
+            .collect();
+        let numeric_knobs: Vec<&String> = knobbed.iter().filter(|k| k.1).map(|k| &k.0).collect();
+        assert_eq!(numeric_knobs, numeric);
+        for (key, leaf) in &fields {
+            let knob = knobbed.iter().find(|k| &k.0 == key);
+            if *leaf == Leaf::Bool {
+                assert!(knob.is_some(), "the switch {key} has no knob");
+            }
+        }
+        for (key, numeric) in &knobbed {
+            let leaf = fields.iter().find(|f| &f.0 == key).map(|f| f.1);
+            assert!(
+                *numeric || leaf == Some(Leaf::Bool) || leaf == Some(Leaf::Text),
+                "{key}"
+            );
+        }
     }
 
     #[test]

@@ -72,6 +72,12 @@ impl ShadowParams {
         }
     }
 
+    /// Side of the map's finest texel, the one under its centre, for a map of `texels` per side:
+    /// the warp's slope at the centre, `k`, times the mean texel size, metres.
+    pub fn finest_texel_m(&self, texels: u32) -> f32 {
+        self.warp * 2.0 * self.half_extent_m / texels.max(1) as f32
+    }
+
     /// Ground-plane offset in half extents of texel coordinate `s` in `[-1, 1]`:
     /// `s (k + (1 - k) |s|)` (`environment_shadow_offset`).
     pub fn offset_of(&self, s: f32) -> f32 {
@@ -161,6 +167,47 @@ impl ShadowParams {
 }
 
 /// Lowest and highest world heights of the field's clouds at the origin, and whether it has any.
+/// Reuse of the map across frames, for a real-time host: the map is built once and read until the
+/// eye or the clouds have moved too far, the sun has moved or the map's settings changed. Between
+/// builds the shadows lag the clouds by at most the drift allowed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowReuse {
+    /// The map is rebuilt once its centre (under the eye) and the clouds (with the wind) have
+    /// moved, together, this many of its finest texels since it was built.
+    pub max_drift_texels: f32,
+}
+
+/// What a built map was built for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BuiltShadow {
+    /// Where it lies and what it sampled.
+    pub params: ShadowParams,
+    /// The unit direction to the sun.
+    pub sun: Vec3,
+    /// Texels per side.
+    pub texels: u32,
+    /// Scene time of the clouds it sampled, s.
+    pub time_s: f32,
+}
+
+impl BuiltShadow {
+    /// Whether this map still serves a frame that would build `fresh` while the clouds move at
+    /// `wind_m_per_s`: the same sun, size and settings, and its centre and the clouds within
+    /// `reuse`'s drift.
+    pub fn serves(&self, fresh: &BuiltShadow, wind_m_per_s: Vec2, reuse: ShadowReuse) -> bool {
+        let recentred = ShadowParams {
+            centre_m: self.params.centre_m,
+            ..fresh.params
+        };
+        if recentred != self.params || fresh.sun != self.sun || fresh.texels != self.texels {
+            return false;
+        }
+        let eye_m = (fresh.params.centre_m - self.params.centre_m).length();
+        let clouds_m = wind_m_per_s.length() * (fresh.time_s - self.time_s).abs();
+        eye_m + clouds_m <= reuse.max_drift_texels * self.params.finest_texel_m(self.texels)
+    }
+}
+
 fn cloud_heights(field: &CloudField) -> (f32, f32, bool) {
     let layers = field.altitude_range_m();
     let volumes = field

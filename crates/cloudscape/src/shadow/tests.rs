@@ -78,3 +78,41 @@ fn the_map_reads_the_columns_and_a_clear_sky_casts_nothing() {
     let clear_map = CloudShadowMap::build(&clear_field, clear_params, sun(), (8, 0.0));
     assert_eq!(clear_map.optical_depth(Vec3::ZERO, 0), 0.0);
 }
+
+#[test]
+fn a_built_map_serves_until_the_eye_and_the_clouds_drift_too_far() {
+    let (scene, field) = scene_field();
+    let at = |x: f32, time_s: f32, sun: Vec3| BuiltShadow {
+        params: ShadowParams::new(&scene, &field, Vec3::new(x, 30.0, 0.0), sun),
+        sun,
+        texels: 256,
+        time_s,
+    };
+    let built = at(0.0, 0.0, sun());
+    let texel_m = built.params.finest_texel_m(256);
+    let texel = |i| {
+        let a = built.params.ground_point((i, 0), 256).x;
+        built.params.ground_point((i + 1, 0), 256).x - a
+    };
+    // The texel beside the centre is a little larger: the warp grows away from it.
+    assert!(
+        (texel(128) - texel_m).abs() < 0.05 * texel_m,
+        "{} {texel_m}",
+        texel(128)
+    );
+    let reuse = ShadowReuse {
+        max_drift_texels: 0.5,
+    };
+    let wind = Vec2::new(6.0, 8.0);
+    let served = |fresh: BuiltShadow| built.serves(&fresh, wind, reuse);
+    assert!(served(at(0.2 * texel_m, 0.0, sun())));
+    assert!(!served(at(0.6 * texel_m, 0.0, sun())));
+    let half_texel_s = 0.5 * texel_m / 10.0;
+    assert!(served(at(0.0, 0.9 * half_texel_s, sun())));
+    assert!(!served(at(0.3 * texel_m, 0.5 * half_texel_s, sun())));
+    assert!(!served(at(0.0, 0.0, Vec3::Y)));
+    assert!(!served(BuiltShadow {
+        texels: 128,
+        ..built
+    }));
+}

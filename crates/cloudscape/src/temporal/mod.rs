@@ -11,11 +11,14 @@ use crate::gpu::pipeline::{
 };
 use crate::gpu::{GpuContext, PassTimer};
 use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT, CloudOutput, SampleGrid};
+use crate::scene::knobs::Allowed::Between;
+use crate::scene::knobs::{Knob, knob};
 use bytemuck::{Pod, Zeroable};
+use documented::DocumentedFields;
 use glam::{Mat4, UVec2, Vec2, Vec3};
 
 /// How temporal reuse trades rays for history.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, DocumentedFields)]
 pub struct TemporalSettings {
     /// 1, 2 or 4: march one ray per divisor x divisor block per frame (4 updates 1/16 of the pixels,
     /// as Horizon Zero Dawn does).
@@ -46,6 +49,16 @@ impl Default for TemporalSettings {
         }
     }
 }
+
+/// The knobs of temporal reuse a host may offer its users (the grid's divisor is a choice of 1, 2
+/// or 4, not a range).
+#[rustfmt::skip]
+pub const KNOBS: &[Knob<TemporalSettings>] = &[
+    knob!(TemporalSettings, blend_per_frame, Between(0.01, 1.0), ""),
+    knob!(TemporalSettings, clip_gamma, Between(0.25, 4.0), ""),
+    knob!(TemporalSettings, cut_distance_m, Between(10.0, 1.0e5), "m"),
+    knob!(TemporalSettings, distance_tolerance, Between(0.01, 1.0), ""),
+];
 
 impl TemporalSettings {
     /// Weight of a pixel's own fresh sample: 1 - (1 - blend)^(divisor^2).
