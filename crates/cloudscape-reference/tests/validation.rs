@@ -8,7 +8,7 @@ use cloudscape_reference::medium::HomogeneousBox;
 use cloudscape_reference::sampling::{cosine_hemisphere, uniform_sphere};
 use glam::{UVec2, Vec3};
 use support::adding_doubling::{Slab, diffuse_reflectance_transmittance};
-use support::{environment, mean_and_error, slab, tracer, two_tone_sky};
+use support::{environment, mean_and_error, slab, sun, tracer, two_tone_sky};
 
 /// White furnace: a non-absorbing medium inside a uniform sky of radiance 1 neither adds nor
 /// removes light, so every view of it has radiance 1, whatever the phase function.
@@ -120,18 +120,11 @@ fn conservative_slab_matches_adding_doubling() {
 /// next-event estimation, the sun probe and the sun disc seen directly.
 #[test]
 fn sunlit_conservative_slab_conserves_energy() {
-    use cloudscape_reference::environment::SunDisc;
-    let sun = SunDisc {
-        direction: Vec3::Y,
-        irradiance: Vec3::ONE,
-        cos_radius: 5f32.to_radians().cos(),
-        limb_darkening: 0.0,
-    };
     let t = tracer(
         slab(2.0),
         PhaseLobes::approximate_mie(20.0),
         1.0,
-        environment(two_tone_sky(0.0, 0.0), Some(sun)),
+        environment(two_tone_sky(0.0, 0.0), Some(sun(Vec3::Y, 5.0))),
         UVec2::ONE,
     );
     let flux = |origin: Vec3, up: Vec3| {
@@ -232,19 +225,12 @@ fn seeds_agree_within_variance_and_repeat_exactly() {
 /// sample count without the probe); the sun probe draws it on purpose (0.06).
 #[test]
 fn the_forward_peak_under_a_slab_converges() {
-    use cloudscape_reference::environment::SunDisc;
     let sun_direction = Vec3::new(0.5, 0.75f32.sqrt(), 0.0);
-    let sun = SunDisc {
-        direction: sun_direction,
-        irradiance: Vec3::ONE,
-        cos_radius: 0.2679f32.to_radians().cos(),
-        limb_darkening: 0.0,
-    };
     let t = tracer(
         slab(4.0),
         PhaseLobes::approximate_mie(20.0),
         1.0,
-        environment(two_tone_sky(0.0, 0.0), Some(sun)),
+        environment(two_tone_sky(0.0, 0.0), Some(sun(sun_direction, 0.2679))),
         UVec2::ONE,
     );
     let view = glam::Quat::from_rotation_z(25f32.to_radians()) * sun_direction;

@@ -43,6 +43,16 @@ pub fn environment(sky: SkyRadiance, sun: Option<SunDisc>) -> Environment {
     }
 }
 
+/// A sun of irradiance 1 along `direction`, with angular radius `radius_deg` and no limb darkening.
+pub fn sun(direction: Vec3, radius_deg: f32) -> SunDisc {
+    SunDisc {
+        direction,
+        irradiance: Vec3::ONE,
+        cos_radius: radius_deg.to_radians().cos(),
+        limb_darkening: 0.0,
+    }
+}
+
 /// A path tracer of `medium` in `environment`; the camera is the default scene's at `size`.
 pub fn tracer(
     medium: HomogeneousBox,
