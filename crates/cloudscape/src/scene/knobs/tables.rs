@@ -119,6 +119,7 @@ pub const VOLUME: &[Knob<VolumeGrid>] = &[
     knob!(VolumeGrid, center_m, Finite, "m"),
     knob!(VolumeGrid, size_m, Above(0.0), "m"),
     knob!(VolumeGrid, extinction_per_m, Between(0.0, 10.0), "m^-1"),
+    knob!(VolumeGrid, sanitize, Listed, ""),
 ];
 
 /// The knobs of each hand-made sprite cloud (`sprite_clouds.N.`).
