@@ -13,10 +13,11 @@
 //!   horizontal surface the same irradiance, `H + (Z - H) 2 / (k + 2)` for the gradient
 //!   `L = H + (Z - H) sin(elevation)^k` (its cosine-weighted mean over the upper hemisphere);
 //! - the clouds as a `cube` over the grid box holding a `heterogeneous` medium whose extinction is
-//!   the grid times `extinction_per_m`; the phase function as one or two HG lobes with the scene's
-//!   mean cosine (exact for `hg` and `dual_hg`; for `mie`, the Draine lobe of Jendersie & d'Eon
-//!   2023 becomes an HG lobe of the same mean cosine, which keeps the multiply scattered light by
-//!   the similarity relations of Wyman et al. 1989 but not the exact forward peak);
+//!   the grid times `extinction_per_m`; the phase function exact as one or two HG lobes (`hg`,
+//!   `blendphase`) for `hg` and `dual_hg`; for `mie`, the Draine-HG mixture of Jendersie & d'Eon
+//!   2023 as a `tabphase` table of 65537 values over the scattering cosine, which keeps the
+//!   function's integral and mean cosine and spreads its forward peak over the last 0.45 deg
+//!   (`approximations::tabulate_phase`);
 //! - the ground, when enabled, as a flat diffuse `rectangle` at `y = 0` reaching `far_m` around the
 //!   camera (the planet's curvature is ignored).
 
@@ -24,7 +25,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::approximations::{HgLobe, constant_sky_radiance, hg_lobes};
+use super::approximations::{ExportedPhase, HgLobe, constant_sky_radiance, exported_phase};
 use super::xml::Element;
 use crate::field::voxel::{VoxelError, VoxelGrid};
 use crate::fsutil::write_bytes_atomically;
@@ -201,7 +202,7 @@ fn clouds_shape(scene: &Scene, grid: &VoxelGrid, extinction_per_m: f32) -> Eleme
         .child(density)
         .child(float("scale", extinction_per_m))
         .child(float("albedo", scene.lighting.albedo))
-        .child(phase(&hg_lobes(&scene.phase)));
+        .child(phase(&exported_phase(&scene.phase)));
     let to_world = Element::new("transform")
         .attr("name", "to_world")
         .child(xyz("scale", half_size))
@@ -212,10 +213,18 @@ fn clouds_shape(scene: &Scene, grid: &VoxelGrid, extinction_per_m: f32) -> Eleme
         .child(medium)
 }
 
-/// One lobe as `hg`; two as `blendphase`, whose `weight` is the share of its second child.
-fn phase(lobes: &[HgLobe]) -> Element {
+/// A table as `tabphase` (its `values`, comma-separated, from `cos_theta = -1` to 1); one HG lobe
+/// as `hg`; two as `blendphase`, whose `weight` is the share of its second child.
+fn phase(exported: &ExportedPhase) -> Element {
+    let lobes = match exported {
+        ExportedPhase::Table(values) => {
+            let values: Vec<String> = values.iter().map(f32::to_string).collect();
+            return plugin("phase", "tabphase").child(string("values", &values.join(", ")));
+        }
+        ExportedPhase::Lobes(lobes) => lobes,
+    };
     let hg = |lobe: &HgLobe| plugin("phase", "hg").child(float("g", lobe.g));
-    match lobes {
+    match lobes.as_slice() {
         [first, second] => plugin("phase", "blendphase")
             .child(float("weight", second.weight))
             .child(hg(first).attr("name", "phase_0"))
@@ -339,13 +348,13 @@ mod tests {
             "<string name=\"filename\" value=\"clouds.vol\"/>",
             "<float name=\"scale\" value=\"0.06\"/>",
             "<float name=\"albedo\" value=\"1\"/>",
-            "<phase type=\"blendphase\">",
+            "<phase type=\"tabphase\">",
             "<shape type=\"rectangle\">",
             "<rgb name=\"reflectance\" value=\"0.12, 0.13, 0.1\"/>",
         ] {
             assert!(xml.contains(expected), "{expected} missing from\n{xml}");
         }
-        assert_eq!(xml.matches("<phase type=\"hg\"").count(), 2);
+        assert!(!xml.contains("<phase type=\"hg\""));
         assert_eq!(grid, test_grid());
     }
 
@@ -411,6 +420,37 @@ mod tests {
         assert!(xml.contains("<float name=\"g\" value=\"0.85\"/>"));
         assert!(!xml.contains("blendphase") && !xml.contains("rectangle"));
         assert!(xml.contains("<rgb name=\"radiance\" value=\"0.03, 0.07, 0.23\"/>"));
+    }
+
+    /// The default (`mie`) phase function is written as the table, back-scattering value first.
+    #[test]
+    fn mie_phase_is_the_table() {
+        let (_, xml) = export("mie", &Scene::default());
+        let marker = "<string name=\"values\" value=\"";
+        let rest = &xml[xml.find(marker).expect("tabphase values missing") + marker.len()..];
+        let written: Vec<f32> = rest[..rest.find('"').unwrap()]
+            .split(',')
+            .map(|v| v.trim().parse().unwrap())
+            .collect();
+        let ExportedPhase::Table(expected) = exported_phase(&Scene::default().phase) else {
+            panic!("mie is tabulated");
+        };
+        assert_eq!(written, expected);
+        assert!(written[0] < *written.last().unwrap());
+    }
+
+    #[test]
+    fn dual_hg_is_a_blend_of_two_hg_lobes() {
+        let mut scene = Scene::default();
+        scene.phase.model = PhaseModel::DualHg;
+        let (_, xml) = export("dual-hg", &scene);
+        assert!(xml.contains("<phase type=\"blendphase\">"), "{xml}");
+        assert_eq!(xml.matches("<phase type=\"hg\"").count(), 2);
+        assert!(
+            xml.contains("<float name=\"weight\" value=\"0.3\"/>"),
+            "{xml}"
+        );
+        assert!(!xml.contains("tabphase"));
     }
 
     #[test]

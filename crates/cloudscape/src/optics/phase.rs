@@ -94,8 +94,8 @@ impl PhaseLobes {
         self.eval_f64(f64::from(cos_theta)) as f32
     }
 
-    /// [`Self::eval`] in double precision.
-    fn eval_f64(&self, mu: f64) -> f64 {
+    /// [`Self::eval`] in double precision (the exporter tabulates it for Mitsuba 3).
+    pub(crate) fn eval_f64(&self, mu: f64) -> f64 {
         let w = f64::from(self.w_draine);
         (1.0 - w) * hg_f64(f64::from(self.g_hg), mu)
             + w * draine_f64(f64::from(self.g_draine), f64::from(self.alpha), mu)
