@@ -42,12 +42,17 @@ pub struct BenchArgs {
     /// (repeatable).
     #[arg(long, value_name = "KEY=VALUE,...")]
     variant: Vec<String>,
-    /// Soak: render this many frames at a small size (160x90 unless --width/--height) with
-    /// temporal reuse, a moving camera and a live edit every 250 frames, and fail if resident
-    /// or GPU memory grows over 1 % from the warm-up to the end.
+    /// Soak: render at least this many frames at a small size (160x90 unless --width/--height)
+    /// with temporal reuse, a moving camera and a live edit every `--soak-edit-every` frames, in
+    /// whole cycles of the seven edits (so the end is in the state the start was), and fail if
+    /// resident or GPU memory grows over 1 % from the warm-up to the end.
     #[arg(long, value_name = "FRAMES", conflicts_with = "flythrough",
           value_parser = clap::value_parser!(u32).range(1..))]
     soak: Option<u32>,
+    /// Frames between two live edits of the soak.
+    #[arg(long, value_name = "FRAMES", default_value_t = 250, requires = "soak",
+          value_parser = clap::value_parser!(u32).range(1..))]
+    soak_edit_every: u32,
     #[command(flatten)]
     flythrough: flythrough::FlythroughArgs,
     #[command(flatten)]

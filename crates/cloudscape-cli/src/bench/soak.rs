@@ -1,8 +1,10 @@
-//! `cloudscape bench --soak N`: a long session as a game runs one. N frames at a small size with
-//! temporal reuse, a camera that keeps moving and turning, and a live edit of the scene every
-//! [`CHANGE_EVERY`] frames (coverage, sun, technique, in turn). Resident memory and what wgpu
-//! reports of the GPU (allocated bytes, live objects) are taken after a warm-up that makes every
-//! edit once, and at the end; growth beyond [`MAX_GROWTH`] of any of them (on a CPU adapter,
+//! `cloudscape bench --soak N`: a long session as a game runs one. At least N frames at a small
+//! size with temporal reuse, a camera that keeps moving and turning, and a live edit of the scene
+//! every `--soak-edit-every` frames (coverage, sun, technique, in turn), in whole cycles of the
+//! [`EDITS`]: the run ends in the state it started in, so the figures compare like with like.
+//! Resident memory and what wgpu reports of the GPU (allocated bytes, live objects) are taken after
+//! a warm-up that makes every edit once, and again at the end of each cycle;
+//! growth beyond [`MAX_GROWTH`] of any of them from the start to the end (on a CPU adapter,
 //! resident memory may also grow by the device memory reserved at the start, which the driver
 //! pages in as it is used), a non-finite pixel in the last frame or any error fails the run.
 
@@ -16,8 +18,6 @@ use cloudscape::scene::SceneDocument;
 use glam::UVec2;
 use serde::Serialize;
 
-/// Frames between two live edits.
-const CHANGE_EVERY: u32 = 250;
 /// The live edits, made in turn and cycled: each is a `--set` override on top of the earlier ones.
 const EDITS: [&str; 7] = [
     "layers.0.coverage=0.35",
@@ -91,7 +91,10 @@ struct SoakReport {
     software: bool,
     width: u32,
     height: u32,
+    /// Frames soaked: the frames asked for, rounded up to whole cycles of the edits.
     frames: u32,
+    /// Frames between two live edits.
+    edit_every: u32,
     warmup_frames: u32,
     edits: u32,
     start: Snapshot,
@@ -109,14 +112,17 @@ pub fn run(args: &BenchArgs, frames: u32) -> Result<()> {
     let ctx = args.gpu.open(&doc)?;
     let mut soak = Soak::new(args, &ctx, size_overrides)?;
     eprintln!("warming up: every edit once, {} frames each", args.warmup);
-    for edit in 0..EDITS.len() {
-        soak.edit(&ctx, edit)?;
-        soak.frames(&ctx, args.warmup, None)?;
-    }
+    soak.cycle(&ctx, args.warmup, None)?;
     let start = Snapshot::take(&ctx);
+    let cycle_frames = args.soak_edit_every * EDITS.len() as u32;
+    let cycles = frames.div_ceil(cycle_frames);
     let bar = progress_bar("soaking");
-    bar.set_length(u64::from(frames));
-    soak.frames(&ctx, frames, Some(&bar))?;
+    bar.set_length(u64::from(cycles * cycle_frames));
+    for cycle in 1..=cycles {
+        soak.cycle(&ctx, args.soak_edit_every, Some(&bar))?;
+        let line = format!("cycle {cycle}: {}", Snapshot::take(&ctx).line());
+        bar.suspend(|| eprintln!("{line}"));
+    }
     bar.finish_and_clear();
     soak.check_last_frame(&ctx)?;
     let end = Snapshot::take(&ctx);
@@ -125,7 +131,8 @@ pub fn run(args: &BenchArgs, frames: u32) -> Result<()> {
         software: ctx.adapter_info().device_type == wgpu::DeviceType::Cpu,
         width: soak.size.x,
         height: soak.size.y,
-        frames,
+        frames: cycles * cycle_frames,
+        edit_every: args.soak_edit_every,
         warmup_frames: args.warmup * EDITS.len() as u32,
         edits: soak.edits,
         start,
@@ -183,19 +190,25 @@ impl<'a> Soak<'a> {
         Ok(())
     }
 
-    /// Renders `count` frames, making the next edit every [`CHANGE_EVERY`] frames.
-    fn frames(
+    /// Makes every edit of [`EDITS`] in turn, each followed by `frames_each` frames (counted on
+    /// `bar`).
+    fn cycle(
         &mut self,
         ctx: &GpuContext,
-        count: u32,
+        frames_each: u32,
         bar: Option<&indicatif::ProgressBar>,
     ) -> Result<()> {
+        for _ in 0..EDITS.len() {
+            self.edit(ctx, self.edits as usize)?;
+            self.frames(ctx, frames_each, bar);
+        }
+        Ok(())
+    }
+
+    /// Renders `count` frames (counted on `bar`).
+    fn frames(&mut self, ctx: &GpuContext, count: u32, bar: Option<&indicatif::ProgressBar>) {
         let reuse = temporal_reuse(self.args.temporal.unwrap_or(4));
-        for i in 0..count {
-            if let Some(bar) = bar.filter(|_| i > 0 && i % CHANGE_EVERY == 0) {
-                bar.println(format!("frame {i}: {}", Snapshot::take(ctx).line()));
-                self.edit(ctx, self.edits as usize)?;
-            }
+        for _ in 0..count {
             let frame = self.moving_frame();
             self.renderer
                 .render_frame(ctx, &self.doc.scene, &frame, reuse, &mut self.timer);
@@ -204,7 +217,6 @@ impl<'a> Soak<'a> {
                 bar.inc(1);
             }
         }
-        Ok(())
     }
 
     /// This frame's view: the scene's camera carried along x and turned a little more each frame.
@@ -244,13 +256,14 @@ impl<'a> Soak<'a> {
 fn print_and_check(report: &SoakReport, print: bool) -> Result<()> {
     if print {
         println!(
-            "soak on {}: {} frames at {}x{} after {} warm-up frames, {} live edits",
+            "soak on {}: {} frames at {}x{} after {} warm-up frames, {} live edits (one every {} frames)",
             report.adapter,
             report.frames,
             report.width,
             report.height,
             report.warmup_frames,
-            report.edits
+            report.edits,
+            report.edit_every
         );
         println!("{:<26} {:>14} {:>14} {:>9}", "", "start", "end", "change");
     }

@@ -199,7 +199,9 @@ fn a_short_soak_keeps_its_memory_and_reports_it() {
     let args = [
         "bench",
         "--soak",
-        "300",
+        "70",
+        "--soak-edit-every",
+        "10",
         "--warmup",
         "2",
         "--width",
@@ -211,7 +213,12 @@ fn a_short_soak_keeps_its_memory_and_reports_it() {
     ];
     let run = cloudscape(scratch.path(), &args, true);
     assert!(run.success, "{}\n{}", run.stdout, run.stderr);
-    for figure in ["resident memory", "live wgpu objects", "8 live edits"] {
+    for figure in [
+        "resident memory",
+        "live wgpu objects",
+        "14 live edits",
+        "cycle 1:",
+    ] {
         assert!(run.stdout.contains(figure), "{figure}:\n{}", run.stdout);
     }
 }

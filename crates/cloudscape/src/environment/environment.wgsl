@@ -184,14 +184,13 @@ fn environment_aerial_texel_uv(uv: vec2<f32>, k: f32) -> vec2<f32> {
 
 // Texel coordinate in [-1, 1] of ground-plane offset x (in half extents, -1..1) in the warped
 // cloud-shadow map: the inverse of x = s (k + (1 - k) |s|), k the warp (CloudShadowMap::texel_of).
+// Branch-free on purpose: lavapipe (Mesa 22.3) recompiles a shader with a branch on uniform values
+// alone whenever those values change, and leaks each compilation (docs/hardening.md, "Soak").
 fn environment_shadow_coord(x: f32) -> f32 {
     let k = environment.shadow.warp;
     let a = abs(x);
-    var s = a;
-    if k < 1.0 {
-        s = (-k + sqrt(k * k + 4.0 * (1.0 - k) * a)) / (2.0 * (1.0 - k));
-    }
-    return sign(x) * s;
+    let warped = (-k + sqrt(k * k + 4.0 * (1.0 - k) * a)) / (2.0 * max(1.0 - k, 1e-6));
+    return sign(x) * select(a, warped, k < 1.0);
 }
 
 // Ground-plane offset (in half extents) of texel coordinate s: x = s (k + (1 - k) |s|), fine texels
