@@ -1,16 +1,17 @@
-//! A frame loop that changes nothing but the frame keeps the process's memory flat: each frame's
-//! passes allocate nothing that outlives it, in this library or in the driver beneath.
+//! A frame loop that changes nothing but the frame keeps the process's memory flat, with every
+//! technique: each frame's passes allocate nothing that outlives it, in this library or in the
+//! driver beneath.
 //!
-//! The regression it guards: lavapipe (Mesa 22.3) recompiles a compute shader whose branch depends
-//! on uniform values alone each time the uniform buffer is rewritten, and leaks every compilation.
+//! The regression it guards: lavapipe (Mesa 22.3) recompiles a shader whose branch depends on
+//! uniform values alone each time the uniform buffer is rewritten, and leaks every compilation.
 //! The aerial-perspective pass had one such branch (the shadow map's warp) and grew the process by
-//! about 350 KB a frame (docs/hardening.md, "Soak"). The test is alone in its binary, so no other
-//! test's allocations move the figure.
+//! about 350 KB a frame, the sprites' shaders by about 100 KB (docs/hardening.md, "Soak"). The test
+//! is alone in its binary, so no other test's allocations move the figure.
 
 use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, PassTimer};
 use cloudscape::renderer::{PASS_COUNT, Reuse, SceneRenderer};
-use cloudscape::scene::SceneDocument;
+use cloudscape::scene::{SceneDocument, Technique};
 use cloudscape::temporal::TemporalSettings;
 use glam::UVec2;
 
@@ -28,16 +29,29 @@ const MAX_GROWTH_BYTES: u64 = MEASURED_FRAMES as u64 * 350 * 1024 / 8;
 #[cfg(target_os = "linux")]
 #[test]
 fn frames_of_an_unchanged_scene_keep_resident_memory_flat() {
+    let ctx = GpuContext::for_tests();
+    for technique in [
+        Technique::Raymarch,
+        Technique::Particles,
+        Technique::Sprites,
+    ] {
+        steady_frames(&ctx, technique);
+    }
+}
+
+/// Renders the default scene with `technique` and checks resident memory over the measured frames.
+#[cfg(target_os = "linux")]
+fn steady_frames(ctx: &GpuContext, technique: Technique) {
     let overrides = [
         format!("render.width={}", SIZE.x),
         format!("render.height={}", SIZE.y),
         "render.quality=low".to_string(),
+        format!("render.technique={}", technique.name()),
     ];
     let doc = SceneDocument::load(None, &overrides).expect("the default scene loads");
-    let ctx = GpuContext::for_tests();
     let mut renderer =
-        SceneRenderer::new(&ctx, &doc.scene, &doc.resolve_path("")).expect("field builds");
-    let mut timer = PassTimer::new(&ctx, PASS_COUNT);
+        SceneRenderer::new(ctx, &doc.scene, &doc.resolve_path("")).expect("field builds");
+    let mut timer = PassTimer::new(ctx, PASS_COUNT);
     let reuse = Reuse::Temporal(TemporalSettings {
         divisor: 4,
         ..TemporalSettings::default()
@@ -47,18 +61,19 @@ fn frames_of_an_unchanged_scene_keep_resident_memory_flat() {
             frame_index: index,
             ..Frame::from_scene(&doc.scene, SIZE)
         };
-        renderer.render_frame(&ctx, &doc.scene, &frame, reuse, &mut timer);
+        renderer.render_frame(ctx, &doc.scene, &frame, reuse, &mut timer);
     };
     (0..WARMUP_FRAMES).for_each(&mut render);
     let before = resident_bytes();
     (WARMUP_FRAMES..WARMUP_FRAMES + MEASURED_FRAMES).for_each(&mut render);
     let after = resident_bytes();
     let growth = after.saturating_sub(before);
-    eprintln!("resident memory over {MEASURED_FRAMES} frames: {before} -> {after} bytes");
+    let name = technique.name();
+    eprintln!("{name}: resident memory over {MEASURED_FRAMES} frames: {before} -> {after} bytes");
     assert!(
         growth <= MAX_GROWTH_BYTES,
-        "resident memory grew {growth} bytes over {MEASURED_FRAMES} frames ({before} -> {after}); \
-         at most {MAX_GROWTH_BYTES} allowed"
+        "{name}: resident memory grew {growth} bytes over {MEASURED_FRAMES} frames \
+         ({before} -> {after}); at most {MAX_GROWTH_BYTES} allowed"
     );
 }
 

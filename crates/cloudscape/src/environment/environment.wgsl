@@ -75,13 +75,19 @@ fn environment_table_multiple_scattering(r: f32, mu_s: f32) -> vec3<f32> {
     return textureSampleLevel(environment_multiple_scattering, environment_linear, uv, 0.0).rgb;
 }
 
+// Whether the sky is the atmosphere's (its tables) rather than an analytic one. The functions below
+// choose between the two by `select`, never by a branch on this alone: lavapipe (Mesa 22.3)
+// recompiles a shader with a branch on uniform values alone each time they are uploaded, and leaks
+// every compilation (docs/hardening.md, "Soak").
+fn environment_is_atmosphere() -> bool {
+    return environment.sky_model == 1u;
+}
+
 // Transmittance of the air from p toward the sun (1 for the analytic skies).
 fn environment_sun_transmittance(p: vec3<f32>) -> vec3<f32> {
-    if environment.sky_model != 1u {
-        return vec3<f32>(1.0);
-    }
     let ru = environment_radius_up(p);
-    return environment_table_sun_transmittance(ru.x, dot(ru.yzw, environment.sun_direction));
+    let air = environment_table_sun_transmittance(ru.x, dot(ru.yzw, environment.sun_direction));
+    return select(vec3<f32>(1.0), air, environment_is_atmosphere());
 }
 
 // Sun irradiance reaching world point p (on a surface facing the sun): Environment::sun_irradiance.
@@ -109,14 +115,13 @@ fn environment_sun_disc_radiance(d: vec3<f32>) -> vec3<f32> {
 // Sky radiance arriving at the viewpoint from direction d (the disc excluded): the sky-view table
 // (atmosphere) or SkyRadiance::radiance.
 fn environment_sky_radiance(d: vec3<f32>) -> vec3<f32> {
-    if environment.sky_model == 1u {
-        let ru = environment_radius_up(environment.viewpoint_m);
-        let angles = atmosphere_local_angles(ru.yzw, d, environment.sun_direction);
-        let uv = atmosphere_sky_view_uv(environment.air, ru.x, angles);
-        return environment.sun_irradiance * textureSampleLevel(environment_sky_view, environment_linear, uv, 0.0).rgb;
-    }
+    let ru = environment_radius_up(environment.viewpoint_m);
+    let angles = atmosphere_local_angles(ru.yzw, d, environment.sun_direction);
+    let uv = atmosphere_sky_view_uv(environment.air, ru.x, angles);
+    let air = environment.sun_irradiance * textureSampleLevel(environment_sky_view, environment_linear, uv, 0.0).rgb;
     let mu = max(d.y, 0.0);
-    return mix(environment.sky_horizon_radiance, environment.sky_zenith_radiance, pow(mu, environment.sky_gradient_exponent));
+    let analytic = mix(environment.sky_horizon_radiance, environment.sky_zenith_radiance, pow(mu, environment.sky_gradient_exponent));
+    return select(analytic, air, environment_is_atmosphere());
 }
 
 // Layer `layer` of the irradiance table at p: 0 the irradiance on an upward surface, 1 the mean
@@ -129,18 +134,14 @@ fn environment_table_irradiance(p: vec3<f32>, layer: i32) -> vec3<f32> {
 
 // Mean sky radiance over the upper hemisphere at p: Environment::sky_mean_radiance_up.
 fn environment_sky_mean_radiance_up(p: vec3<f32>) -> vec3<f32> {
-    if environment.sky_model == 1u {
-        return environment_table_irradiance(p, 1);
-    }
-    return mix(environment.sky_horizon_radiance, environment.sky_zenith_radiance, 1.0 / (1.0 + environment.sky_gradient_exponent));
+    let analytic = mix(environment.sky_horizon_radiance, environment.sky_zenith_radiance, 1.0 / (1.0 + environment.sky_gradient_exponent));
+    return select(analytic, environment_table_irradiance(p, 1), environment_is_atmosphere());
 }
 
 // Sky irradiance on an upward-facing surface at p: Environment::sky_irradiance_up.
 fn environment_sky_irradiance_up(p: vec3<f32>) -> vec3<f32> {
-    if environment.sky_model == 1u {
-        return environment_table_irradiance(p, 0);
-    }
-    return PI * mix(environment.sky_horizon_radiance, environment.sky_zenith_radiance, 2.0 / (2.0 + environment.sky_gradient_exponent));
+    let analytic = PI * mix(environment.sky_horizon_radiance, environment.sky_zenith_radiance, 2.0 / (2.0 + environment.sky_gradient_exponent));
+    return select(analytic, environment_table_irradiance(p, 0), environment_is_atmosphere());
 }
 
 // Radiance leaving a Lambertian ground of `albedo` at p under the unshadowed sun and sky:
@@ -156,10 +157,8 @@ fn environment_ground_radiance(albedo: vec3<f32>, p: vec3<f32>) -> vec3<f32> {
 // or the analytic skies' haze, fading toward the horizon radiance by exp(-haze distance)
 // (Koschmieder 1924). Applied once, in compositing: Environment::aerial_perspective.
 fn environment_aerial_perspective(radiance: vec3<f32>, coverage: f32, uv: vec2<f32>, distance_m: f32) -> vec3<f32> {
-    if environment.sky_model != 1u {
-        let clear = exp(-environment.haze_extinction_per_m * distance_m);
-        return radiance * clear + environment.sky_horizon_radiance * coverage * (1.0 - clear);
-    }
+    let clear = exp(-environment.haze_extinction_per_m * distance_m);
+    let hazed = radiance * clear + environment.sky_horizon_radiance * coverage * (1.0 - clear);
     let slices = distance_m / ATMOSPHERE_AERIAL_SLICE_M;
     let w = clamp(slices - 1.0, 0.0, f32(ATMOSPHERE_AERIAL_SLICES - 1u));
     let k0 = floor(w);
@@ -171,7 +170,8 @@ fn environment_aerial_perspective(radiance: vec3<f32>, coverage: f32, uv: vec2<f
     let near = clamp(slices, 0.0, 1.0);
     inscatter *= near;
     transmittance = mix(vec3<f32>(1.0), transmittance, near);
-    return radiance * transmittance + environment.sun_irradiance * inscatter * coverage;
+    let air = radiance * transmittance + environment.sun_irradiance * inscatter * coverage;
+    return select(hazed, air, environment_is_atmosphere());
 }
 
 // Texture coordinates in the aerial-perspective atlas of screen position uv in slice k: the slice's

@@ -46,13 +46,11 @@ fn vs_impostor(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -
 fn fs_impostor(in: Varying) -> SpriteTargets {
     let radiance = textureSample(impostor_radiance, impostor_sampler, in.uv, in.sector);
     let pair = textureSample(impostor_distance, impostor_sampler, in.uv, in.sector);
-    var fade = 1.0;
     let distance_m = pair.x / max(pair.y, 1e-6) * SPRITE_DISTANCE_UNIT_M;
-    if view.host_depth_test == 1u {
-        let texel = in.clip.xy;
-        let depth = textureLoad(host_depth, vec2<i32>(sprite_frame_pixel(texel)), 0).x;
-        fade = sprite_host_fade(depth, texel, distance_m, 200.0);
-    }
+    let texel = in.clip.xy;
+    let depth = textureLoad(host_depth, vec2<i32>(sprite_frame_pixel(texel)), 0).x;
+    // A select, not a branch on the uniform alone (sprite_render.wgsl's sprite_max_colours says why).
+    let fade = select(1.0, sprite_host_fade(depth, texel, distance_m, 200.0), view.host_depth_test == 1u);
     var out: SpriteTargets;
     out.radiance = radiance * fade;
     out.distance = vec4<f32>(pair.x, pair.y, 0.0, pair.y) * fade;

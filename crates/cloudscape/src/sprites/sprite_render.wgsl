@@ -89,17 +89,16 @@ fn sprite_centre(s: Sprite) -> vec3<f32> {
 }
 
 // Wang 2003's maximum ambient and directional colours, or the scene's overrides: the sky's mean
-// radiance from above and the sun's irradiance over pi, times the albedo (shading.rs).
+// radiance from above and the sun's irradiance over pi, times the albedo (shading.rs). Selects,
+// not branches: lavapipe recompiles a shader with a branch on uniform values alone each time they
+// are uploaded, and leaks the compilation (docs/hardening.md, "Soak").
 fn sprite_max_colours(p: vec3<f32>) -> array<vec3<f32>, 2> {
-    var ambient = settings.albedo * environment_sky_mean_radiance_up(p);
-    var directional = settings.albedo * environment_sun_irradiance(p) / PI;
-    if settings.ambient_overridden == 1u {
-        ambient = settings.ambient_override;
-    }
-    if settings.directional_overridden == 1u {
-        directional = settings.directional_override;
-    }
-    return array<vec3<f32>, 2>(ambient, directional);
+    let ambient = settings.albedo * environment_sky_mean_radiance_up(p);
+    let directional = settings.albedo * environment_sun_irradiance(p) / PI;
+    return array<vec3<f32>, 2>(
+        select(ambient, settings.ambient_override, settings.ambient_overridden == 1u),
+        select(directional, settings.directional_override, settings.directional_overridden == 1u),
+    );
 }
 
 @vertex
@@ -158,12 +157,11 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
 fn fs_sprite(in: Varying) -> SpriteTargets {
     // The sheet holds column density normalised to 1 (sprites/textures.rs).
     let cover = textureSample(puffs, puff_sampler, in.uv).r;
-    var alpha = (1.0 - exp(-in.optical_depth * cover)) * in.opacity;
-    if view.host_depth_test == 1u {
-        let texel = in.clip.xy;
-        let depth = textureLoad(host_depth, vec2<i32>(sprite_frame_pixel(texel)), 0).x;
-        alpha *= sprite_host_fade(depth, texel, in.distance_m, in.soft_m);
-    }
+    let texel = in.clip.xy;
+    let depth = textureLoad(host_depth, vec2<i32>(sprite_frame_pixel(texel)), 0).x;
+    let fade = sprite_host_fade(depth, texel, in.distance_m, in.soft_m);
+    // A select, not a branch on the uniform alone (sprite_max_colours says why).
+    let alpha = (1.0 - exp(-in.optical_depth * cover)) * in.opacity * select(1.0, fade, view.host_depth_test == 1u);
     // Thin parts of a puff scatter the direct sun once toward the eye (premultiplied, E p tau ~
     // E p alpha for thin matter); its thick core's light is the diffuse term's.
     let thin = (1.0 - cover) * (1.0 - cover);
