@@ -34,6 +34,7 @@ pub const MODULES: &[WgslModule] = &[
     module("field", include_str!("field/field.wgsl")),
     module("hiheight", include_str!("field/hiheight.wgsl")),
     module("phase", include_str!("optics/phase.wgsl")),
+    module("slab", include_str!("optics/slab.wgsl")),
     module("frame", include_str!("frame/frame.wgsl")),
     module("atmosphere", include_str!("atmosphere/atmosphere.wgsl")),
     module("environment", include_str!("environment/environment.wgsl")),
@@ -140,6 +141,10 @@ pub fn constants_wgsl() -> String {
     put(format!(
         "const MARCH_SUN_PATH_MAX_M: f32 = {:?};",
         crate::raymarch::SUN_PATH_M.1
+    ));
+    put(format!(
+        "const SLAB_MAX_TWO_STREAM_ALBEDO: f32 = {:?};",
+        crate::optics::slab::MAX_TWO_STREAM_ALBEDO
     ));
     atmosphere_constants(&mut put);
     let gradients: Vec<String> = profile::TYPE_GRADIENTS

@@ -6,7 +6,9 @@
 use cloudscape::environment::{Environment, ViewedEnvironment};
 use cloudscape::frame::{DepthConvention, Frame};
 use cloudscape::gpu::GpuContext;
-use cloudscape::optics::{Octaves, PhaseLobes, diffuse_transmittance, two_stream_share_from_below};
+use cloudscape::optics::{
+    Octaves, PhaseLobes, SunSlab, diffuse_transmittance, two_stream_share_from_below,
+};
 use cloudscape::post::tonemap;
 use cloudscape::probe::{Probe, ProbeFunction, ProbeInput};
 use cloudscape::renderer::{CloudRenderer, Reuse};
@@ -565,6 +567,27 @@ fn phase_functions_and_height_profiles_match_the_cpu() {
             .map(|p| Vec4::splat(octaves.scattering(&phase, p.c.x, p.c.y)))
             .collect();
         assert_close(&format!("octaves of {phase:?}"), &got, &want, 1e-4);
+        for albedo in [1.0, 0.9] {
+            let slab = SunSlab::new(phase, albedo, 0.8, 0.6);
+            let inputs: Vec<ProbeInput> = (0..300)
+                .map(|i| ProbeInput {
+                    a: Vec4::from_array(phase.to_gpu()),
+                    b: Vec4::from_array(slab.params_to_gpu()),
+                    c: Vec4::new(
+                        2.0 * unit(i, 27) - 1.0,
+                        80.0 * unit(i, 28).powi(2),
+                        80.0 * unit(i, 29).powi(2),
+                        0.0,
+                    ),
+                })
+                .collect();
+            let got = gpu(&ctx, &clouds, ProbeFunction::SunSlab, &inputs);
+            let want: Vec<Vec4> = inputs
+                .iter()
+                .map(|p| Vec4::splat(slab.scattering(p.c.x, p.c.y, p.c.z)))
+                .collect();
+            assert_close(&format!("slab of {phase:?}, {albedo}"), &got, &want, 5e-4);
+        }
     }
     let cases: Vec<ProbeInput> = (0..300)
         .map(|i| {

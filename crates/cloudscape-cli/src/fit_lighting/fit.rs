@@ -1,13 +1,41 @@
-//! Fitting the octaves' factors to the path tracer, and measuring a fit on held-out scenes.
+//! Fitting the ray marcher's lighting models to the path tracer, and measuring a fit on held-out
+//! scenes.
 
 use super::samples::Sample;
-use cloudscape::optics::{Octaves, PhaseLobes};
+use cloudscape::optics::{Octaves, PhaseLobes, SunSlab};
 use rayon::prelude::*;
 
 /// Grid points per factor in each round of the search.
 const GRID: usize = 11;
 /// Rounds of the search, each on a grid a quarter as wide about the best point of the last.
 const ROUNDS: usize = 4;
+
+/// A model of the sun's light the march adds at a point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Model {
+    /// Multiple-scattering octaves, with the phase function they scale.
+    Octaves(Octaves, PhaseLobes),
+    /// The δ-Eddington slab along the sun.
+    Slab(SunSlab),
+}
+
+impl Model {
+    /// The model's prediction of one sample's source.
+    fn predict(&self, s: &Sample) -> f64 {
+        f64::from(match self {
+            Model::Octaves(octaves, lobes) => octaves.scattering(lobes, s.cos_theta, s.tau_sun),
+            Model::Slab(slab) => slab.scattering(s.cos_theta, s.tau_sun, s.tau_back),
+        })
+    }
+
+    /// The squared error of the model over `samples`.
+    fn squared_error(&self, samples: &[Sample]) -> f64 {
+        samples
+            .iter()
+            .map(|s| (self.predict(s) - f64::from(s.source)).powi(2))
+            .sum()
+    }
+}
 
 /// How well a model predicts a set of samples.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -20,16 +48,11 @@ pub struct Score {
     pub scene_ratio_range: (f64, f64),
 }
 
-/// `octaves`' prediction of one sample's source.
-fn predict(octaves: &Octaves, lobes: &PhaseLobes, s: &Sample) -> f64 {
-    f64::from(octaves.scattering(lobes, s.cos_theta, s.tau_sun))
-}
-
-/// The score of `octaves` on `samples`.
-pub fn score(octaves: &Octaves, lobes: &PhaseLobes, samples: &[Sample]) -> Score {
+/// The score of `model` on `samples`.
+pub fn score(model: &Model, samples: &[Sample]) -> Score {
     let (mut sum_sq, mut sum_pred, mut sum_true) = (0.0, 0.0, 0.0);
     for s in samples {
-        let p = predict(octaves, lobes, s);
+        let p = model.predict(s);
         sum_sq += (p - f64::from(s.source)).powi(2);
         sum_pred += p;
         sum_true += f64::from(s.source);
@@ -43,7 +66,7 @@ pub fn score(octaves: &Octaves, lobes: &PhaseLobes, samples: &[Sample]) -> Score
             .iter()
             .filter(|s| s.scene == k)
             .fold((0.0, 0.0), |(p, t), s| {
-                (p + predict(octaves, lobes, s), t + f64::from(s.source))
+                (p + model.predict(s), t + f64::from(s.source))
             });
         p / t.max(1e-12)
     });
@@ -55,17 +78,37 @@ pub fn score(octaves: &Octaves, lobes: &PhaseLobes, samples: &[Sample]) -> Score
     }
 }
 
-/// The squared error of `octaves` over `samples`.
-fn squared_error(octaves: &Octaves, lobes: &PhaseLobes, samples: &[Sample]) -> f64 {
-    samples
-        .iter()
-        .map(|s| (predict(octaves, lobes, s) - f64::from(s.source)).powi(2))
-        .sum()
+/// The factors within `bounds` that minimise `error`: a grid search refined [`ROUNDS`] times,
+/// each round on a grid a quarter as wide about the best point of the last.
+fn grid_search<const N: usize>(
+    bounds: [(f32, f32); N],
+    error: impl Fn([f32; N]) -> f64 + Sync,
+) -> [f32; N] {
+    let mut centre = bounds.map(|(lo, hi)| 0.5 * (lo + hi));
+    let mut half_width = bounds.map(|(lo, hi)| 0.5 * (hi - lo));
+    for _ in 0..ROUNDS {
+        let candidates: Vec<[f32; N]> = (0..GRID.pow(N as u32))
+            .map(|index| {
+                std::array::from_fn(|k| {
+                    let step = index / GRID.pow(k as u32) % GRID;
+                    let t = step as f32 / (GRID - 1) as f32;
+                    (centre[k] + half_width[k] * (2.0 * t - 1.0)).clamp(bounds[k].0, bounds[k].1)
+                })
+            })
+            .collect();
+        centre = candidates
+            .par_iter()
+            .map(|&f| (error(f), f))
+            .min_by(|x, y| x.0.total_cmp(&y.0))
+            .map(|(_, f)| f)
+            .unwrap_or(centre);
+        half_width = half_width.map(|w| w / 4.0);
+    }
+    centre
 }
 
 /// The factors `(a, b, c)` of `count` octaves that minimise the squared error over `samples`
-/// (least squares: the samples' estimates are unbiased, so their mean is what is fitted), found by
-/// a grid search over `[0, 1]^3` refined [`ROUNDS`] times about the best point.
+/// (least squares: the samples' estimates are unbiased, so their mean is what is fitted).
 pub fn fit_octaves(count: u32, lobes: &PhaseLobes, samples: &[Sample]) -> Octaves {
     let octaves = |[a, b, c]: [f32; 3]| Octaves {
         count,
@@ -73,31 +116,47 @@ pub fn fit_octaves(count: u32, lobes: &PhaseLobes, samples: &[Sample]) -> Octave
         contribution: b,
         eccentricity: c,
     };
-    let (mut centre, mut half_width) = ([0.5f32; 3], 0.5f32);
-    for _ in 0..ROUNDS {
-        let axis = |k: usize| {
-            (0..GRID).map(move |i| {
-                let t = i as f32 / (GRID - 1) as f32;
-                (centre[k] + half_width * (2.0 * t - 1.0)).clamp(0.0, 0.99)
-            })
-        };
-        let candidates: Vec<[f32; 3]> = axis(0)
-            .flat_map(|a| axis(1).flat_map(move |b| axis(2).map(move |c| [a, b, c])))
-            .collect();
-        centre = candidates
-            .par_iter()
-            .map(|&f| (squared_error(&octaves(f), lobes, samples), f))
-            .min_by(|x, y| x.0.total_cmp(&y.0))
-            .map(|(_, f)| f)
-            .unwrap_or(centre);
-        half_width /= 4.0;
-    }
-    octaves(centre)
+    let bounds = [(0.0, 0.99); 3];
+    let best = grid_search(bounds, |f| {
+        Model::Octaves(octaves(f), *lobes).squared_error(samples)
+    });
+    octaves(best)
+}
+
+/// The slab model's diffuse and far-side factors that minimise the squared error over `samples`,
+/// for `lobes` and `albedo`.
+pub fn fit_slab(lobes: PhaseLobes, albedo: f32, samples: &[Sample]) -> SunSlab {
+    let slab = |[diffuse, back]: [f32; 2]| SunSlab::new(lobes, albedo, diffuse, back);
+    let bounds = [(0.0, 2.0), (0.0, 2.0)];
+    slab(grid_search(bounds, |f| {
+        Model::Slab(slab(f)).squared_error(samples)
+    }))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Samples on a grid of scattering cosines and optical depths, their source from `truth`.
+    fn samples_of(truth: impl Fn(&Sample) -> f32) -> Vec<Sample> {
+        (0..400)
+            .map(|i| {
+                let (cos_theta, tau_sun) = ((i % 20) as f32 / 10.0 - 0.95, (i / 20) as f32 * 1.5);
+                let tau_back = ((i * 7) % 30) as f32;
+                let mut sample = Sample {
+                    scene: i % 3,
+                    tau_sun,
+                    tau_back,
+                    cos_theta,
+                    sun_y: 0.5,
+                    source: 0.0,
+                    source_error: 0.0,
+                };
+                sample.source = truth(&sample);
+                sample
+            })
+            .collect()
+    }
 
     /// Samples made by known octaves are fitted back to them.
     #[test]
@@ -109,24 +168,24 @@ mod tests {
             contribution: 0.6,
             eccentricity: 0.5,
         };
-        let samples: Vec<Sample> = (0..400)
-            .map(|i| {
-                let (cos_theta, tau_sun) = ((i % 20) as f32 / 10.0 - 0.95, (i / 20) as f32 * 1.5);
-                let source = truth.scattering(&lobes, cos_theta, tau_sun);
-                Sample {
-                    scene: i % 3,
-                    tau_sun,
-                    cos_theta,
-                    sun_y: 0.5,
-                    source,
-                    source_error: 0.0,
-                }
-            })
-            .collect();
+        let samples = samples_of(|s| truth.scattering(&lobes, s.cos_theta, s.tau_sun));
         let fitted = fit_octaves(4, &lobes, &samples);
-        let s = score(&fitted, &lobes, &samples);
+        let s = score(&Model::Octaves(fitted, lobes), &samples);
         assert!(s.relative_rms < 0.01, "{fitted:?}: {s:?}");
         assert!((fitted.attenuation - 0.3).abs() < 0.02, "{fitted:?}");
         assert!((fitted.contribution - 0.6).abs() < 0.02, "{fitted:?}");
+    }
+
+    /// Samples made by a known slab are fitted back to it.
+    #[test]
+    fn a_known_slab_is_recovered() {
+        let lobes = PhaseLobes::approximate_mie(20.0);
+        let truth = SunSlab::new(lobes, 1.0, 0.7, 0.4);
+        let samples = samples_of(|s| truth.scattering(s.cos_theta, s.tau_sun, s.tau_back));
+        let fitted = fit_slab(lobes, 1.0, &samples);
+        let s = score(&Model::Slab(fitted), &samples);
+        assert!(s.relative_rms < 0.01, "{fitted:?}: {s:?}");
+        assert!((fitted.diffuse_scale - 0.7).abs() < 0.02, "{fitted:?}");
+        assert!((fitted.back_scale - 0.4).abs() < 0.05, "{fitted:?}");
     }
 }

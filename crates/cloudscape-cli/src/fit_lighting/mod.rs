@@ -1,8 +1,9 @@
-//! `cloudscape fit-lighting`: fits the ray marcher's multiple-scattering octaves to the path
-//! tracer. Generated scenes (none of them canonical) are lit by the sun alone; at points inside
-//! their clouds the path tracer estimates the light scattered toward the eye, and the octaves'
-//! factors `(a, b, c)` are chosen to predict it from what the march knows there (its light
-//! samples' optical depth toward the sun and the scattering angle). Held-out scenes score the fit.
+//! `cloudscape fit-lighting`: fits the ray marcher's models of the sun's multiply scattered light
+//! to the path tracer. Generated scenes (none of them canonical) are lit by the sun alone; at
+//! points inside their clouds the path tracer estimates the light scattered toward the eye, and
+//! each model's factors are chosen to predict it from what the march knows there (its light
+//! samples' optical depths toward the sun and away from it, and the scattering angle): the slab
+//! model's diffuse and far-side factors, the octaves' `(a, b, c)`. Held-out scenes score the fits.
 
 mod fit;
 mod samples;
@@ -10,9 +11,9 @@ mod samples;
 use crate::common::progress_bar;
 use anyhow::{Context, Result};
 use clap::Args;
-use cloudscape::optics::{Octaves, PhaseLobes};
+use cloudscape::optics::PhaseLobes;
 use cloudscape::scene::Scene;
-use fit::{Score, fit_octaves, score};
+use fit::{Model, Score, fit_octaves, fit_slab, score};
 use samples::{Sample, scene_samples};
 use std::path::{Path, PathBuf};
 
@@ -49,34 +50,54 @@ pub fn run(args: FitLightingArgs) -> Result<()> {
     )?;
     let defaults = Scene::default();
     let lobes = PhaseLobes::from_scene(&defaults.phase);
-    let current = defaults.lighting.octaves();
-    let fitted = fit_octaves(current.count, &lobes, &training);
+    let lighting = &defaults.lighting;
+    let octaves = lighting.octaves();
+    let fitted_octaves = fit_octaves(octaves.count, &lobes, &training);
+    let fitted_slab = fit_slab(lobes, lighting.albedo, &training);
     println!(
         "{} training samples, {} held out\n",
         training.len(),
         validation.len()
     );
     println!(
-        "| octaves | a | b | c | training rel. RMS | held-out rel. RMS | held-out mean ratio | held-out scene ratios |"
+        "| model | factors | training rel. RMS | held-out rel. RMS | held-out mean ratio | held-out scene ratios |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
-    for (name, o) in [("default", current), ("fitted", fitted)] {
-        let (t, v) = (score(&o, &lobes, &training), score(&o, &lobes, &validation));
-        print_row(name, &o, t, v);
+    println!("|---|---|---|---|---|---|");
+    let models = [
+        ("slab, default", Model::Slab(lighting.sun_slab(lobes))),
+        ("slab, fitted", Model::Slab(fitted_slab)),
+        ("octaves, default", Model::Octaves(octaves, lobes)),
+        ("octaves, fitted", Model::Octaves(fitted_octaves, lobes)),
+    ];
+    for (name, model) in models {
+        print_row(
+            name,
+            &model,
+            score(&model, &training),
+            score(&model, &validation),
+        );
     }
     println!(
-        "\n[lighting]\noctave_attenuation = {:.3}\noctave_contribution = {:.3}\noctave_eccentricity = {:.3}",
-        fitted.attenuation, fitted.contribution, fitted.eccentricity
+        "\n[lighting]\nslab_diffuse_scale = {:.3}\nslab_back_scale = {:.3}\noctave_attenuation = {:.3}\noctave_contribution = {:.3}\noctave_eccentricity = {:.3}",
+        fitted_slab.diffuse_scale,
+        fitted_slab.back_scale,
+        fitted_octaves.attenuation,
+        fitted_octaves.contribution,
+        fitted_octaves.eccentricity
     );
     Ok(())
 }
 
-fn print_row(name: &str, o: &Octaves, training: Score, held_out: Score) {
+fn print_row(name: &str, model: &Model, training: Score, held_out: Score) {
+    let factors = match model {
+        Model::Slab(s) => format!("k {:.3}, back {:.3}", s.diffuse_scale, s.back_scale),
+        Model::Octaves(o, _) => format!(
+            "a {:.3}, b {:.3}, c {:.3}",
+            o.attenuation, o.contribution, o.eccentricity
+        ),
+    };
     println!(
-        "| {name} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.2}..{:.2} |",
-        o.attenuation,
-        o.contribution,
-        o.eccentricity,
+        "| {name} | {factors} | {:.3} | {:.3} | {:.3} | {:.2}..{:.2} |",
         training.relative_rms,
         held_out.relative_rms,
         held_out.mean_ratio,
@@ -113,14 +134,14 @@ fn gather(scenes: std::ops::Range<u32>, args: &FitLightingArgs) -> Result<Vec<Sa
 }
 
 /// Columns of a samples file.
-const HEADER: &str = "scene,tau_sun,cos_theta,sun_y,source,source_error";
+const HEADER: &str = "scene,tau_sun,tau_back,cos_theta,sun_y,source,source_error";
 
 fn write(path: &Path, samples: &[Sample]) -> Result<()> {
     let mut text = format!("{HEADER}\n");
     for s in samples {
         text += &format!(
-            "{},{},{},{},{},{}\n",
-            s.scene, s.tau_sun, s.cos_theta, s.sun_y, s.source, s.source_error
+            "{},{},{},{},{},{},{}\n",
+            s.scene, s.tau_sun, s.tau_back, s.cos_theta, s.sun_y, s.source, s.source_error
         );
     }
     std::fs::write(path, text).with_context(|| path.display().to_string())
@@ -137,13 +158,14 @@ fn read(path: &Path) -> Option<Vec<Sample>> {
                 .split(',')
                 .map(|x| x.parse().ok())
                 .collect::<Option<_>>()?;
-            (v.len() == 6).then(|| Sample {
+            (v.len() == 7).then(|| Sample {
                 scene: v[0] as u32,
                 tau_sun: v[1],
-                cos_theta: v[2],
-                sun_y: v[3],
-                source: v[4],
-                source_error: v[5],
+                tau_back: v[2],
+                cos_theta: v[3],
+                sun_y: v[4],
+                source: v[5],
+                source_error: v[6],
             })
         })
         .collect()

@@ -68,7 +68,8 @@ fn register_font() -> Result<()> {
     .map_err(|e| anyhow!(e))
 }
 
-/// The colour of a family at a shade: the ray marcher's presets from light to deep blue.
+/// The colour of a family at a shade: the ray marcher's presets from light to deep blue, the
+/// particles orange, the sprites green, the ray marcher with the octave model purple.
 fn colour(family: usize, shade: f64) -> RGBColor {
     let mix = |a: (f64, f64, f64), b: (f64, f64, f64)| {
         let t = shade.clamp(0.0, 1.0);
@@ -78,7 +79,8 @@ fn colour(family: usize, shade: f64) -> RGBColor {
     match family {
         0 => mix((120.0, 170.0, 230.0), (20.0, 50.0, 140.0)),
         1 => RGBColor(230, 120, 30),
-        _ => RGBColor(40, 150, 70),
+        2 => RGBColor(40, 150, 70),
+        _ => RGBColor(150, 60, 160),
     }
 }
 

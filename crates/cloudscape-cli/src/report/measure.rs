@@ -7,49 +7,63 @@ use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, PassTimer};
 use cloudscape::image::HdrImage;
 use cloudscape::renderer::{PASS_COUNT, Rendered, Reuse, SceneRenderer};
-use cloudscape::scene::{Quality, Scene, SceneDocument, Technique};
+use cloudscape::scene::{LightingModel, Quality, Scene, SceneDocument, Technique};
 use glam::UVec2;
 use std::path::Path;
 
-/// A technique at one setting: the ray marcher at a quality preset, or a technique whose cost no
-/// preset changes.
+/// A technique at one setting: the ray marcher at a quality preset or with a lighting model, or a
+/// technique whose cost no preset changes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Variant {
     /// The technique.
     pub technique: Technique,
-    /// Its quality preset, where it has them.
+    /// Its quality preset, where it has them; None is the scene's.
     pub quality: Option<Quality>,
+    /// The ray marcher's model of multiple scattering; None is the scene's.
+    pub lighting: Option<LightingModel>,
 }
 
 /// The quality presets from fast to converged.
 const PRESETS: [Quality; 4] = [Quality::Low, Quality::Medium, Quality::High, Quality::Ultra];
 
 impl Variant {
-    /// Every variant the report measures: the ray marcher at each preset, then the particles and
-    /// the sprites (only the ray marcher reads `render.quality`).
+    /// Every variant the report measures: the ray marcher at each preset, the ray marcher with
+    /// the octave model at the scene's preset (the model the slab replaced), then the particles
+    /// and the sprites (only the ray marcher reads `render.quality` and `lighting.model`).
     pub fn all() -> Vec<Variant> {
-        let presets = PRESETS.map(|q| Variant {
-            technique: Technique::Raymarch,
-            quality: Some(q),
-        });
-        let others = [Technique::Particles, Technique::Sprites].map(|technique| Variant {
+        let technique = |technique| Variant {
             technique,
             quality: None,
+            lighting: None,
+        };
+        let presets = PRESETS.map(|q| Variant {
+            quality: Some(q),
+            ..technique(Technique::Raymarch)
         });
-        presets.into_iter().chain(others).collect()
+        let octaves = Variant {
+            lighting: Some(LightingModel::Octaves),
+            ..technique(Technique::Raymarch)
+        };
+        let others = [Technique::Particles, Technique::Sprites].map(technique);
+        presets.into_iter().chain([octaves]).chain(others).collect()
     }
 
-    /// "raymarch high", "particles".
+    /// "raymarch high", "raymarch octaves", "particles".
     pub fn label(&self) -> String {
-        match self.quality {
-            Some(q) => format!("{} {}", self.technique.name(), quality_name(q)),
-            None => self.technique.name().to_string(),
+        let mut label = self.technique.name().to_string();
+        if let Some(q) = self.quality {
+            label += &format!(" {}", quality_name(q));
         }
+        if self.lighting == Some(LightingModel::Octaves) {
+            label += " octaves";
+        }
+        label
     }
 
     /// Whether this is how `scene` renders itself with `technique`.
     pub fn is_scene_default(&self, scene: &Scene) -> bool {
         self.quality.is_none_or(|q| q == scene.render.quality)
+            && self.lighting.is_none_or(|l| l == scene.lighting.model)
     }
 
     /// `scene` set to render this variant.
@@ -58,6 +72,9 @@ impl Variant {
         scene.render.technique = self.technique;
         if let Some(q) = self.quality {
             scene.render.quality = q;
+        }
+        if let Some(l) = self.lighting {
+            scene.lighting.model = l;
         }
         scene
     }

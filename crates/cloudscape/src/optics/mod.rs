@@ -4,9 +4,11 @@
 //! Each CPU formula has a WGSL twin in `phase.wgsl` (the `phase` shader module).
 
 pub mod phase;
+pub mod slab;
 pub mod step;
 
 pub use phase::{Octaves, PhaseLobes, draine, henyey_greenstein};
+pub use slab::SunSlab;
 pub use step::MarchState;
 
 /// Eddington (two-stream) diffuse transmittance of a conservatively scattering slab of optical

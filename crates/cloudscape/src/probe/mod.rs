@@ -62,6 +62,9 @@ pub enum ProbeFunction {
     /// `phase_octaves(lobes a, factors b.xyz, count c.z, cos theta c.x, tau c.y)`:
     /// `Octaves::scattering`.
     Octaves = 21,
+    /// `slab_scattering(SlabModel(lobes a, params b), cos theta c.x, tau_sun c.y, tau_back c.z)`:
+    /// `SunSlab::scattering`.
+    SunSlab = 22,
 }
 
 /// The inputs of one evaluation.

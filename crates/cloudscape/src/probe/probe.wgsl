@@ -1,4 +1,4 @@
-#import hiheight frame environment tonemap phase
+#import hiheight frame environment tonemap phase slab
 // Evaluates one WGSL function that has a CPU twin at given inputs, so tests can hold the GPU
 // against the specification (probe/mod.rs lists the functions and their twins).
 
@@ -40,6 +40,7 @@ fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
         case 19u: { return vec4<f32>(environment_cloud_sky_optical_depth(a.xyz)); }
         case 20u: { return vec4<f32>(frame_two_stream_share_from_below(a.x, a.y)); }
         case 21u: { return vec4<f32>(phase_octaves(a, b.xyz, u32(c.z), c.x, c.y)); }
+        case 22u: { return vec4<f32>(slab_scattering(SlabModel(a, b), c.x, c.y, c.z)); }
         default: { return vec4<f32>(-1.0); }
     }
 }

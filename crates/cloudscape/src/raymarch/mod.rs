@@ -11,9 +11,9 @@ use crate::gpu::pipeline::{
     compute_pipeline, dispatch_2d_repeated, storage_binding, storage_buffer, storage_texture_2d,
     uniform_buffer,
 };
-use crate::optics::{Octaves, PhaseLobes};
+use crate::optics::{Octaves, PhaseLobes, SunSlab};
 use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
-use crate::scene::{Quality, Scene};
+use crate::scene::{LightingModel, Quality, Scene};
 use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, Vec4};
@@ -23,6 +23,12 @@ use glam::{UVec2, Vec4};
 /// shadow is complete, and longer single-sample segments only add noise.
 pub const SUN_PATH_M: (f32, f32) = (50.0, 4000.0);
 
+/// Samples of the march's path away from the sun for `light_steps` toward it: half as many (the
+/// far side only shapes the diffuse light, which varies slowly), at least one.
+pub fn back_steps(light_steps: u32) -> u32 {
+    light_steps.div_ceil(2).max(1)
+}
+
 /// Step counts and lighting of the march.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MarchSettings {
@@ -30,9 +36,16 @@ pub struct MarchSettings {
     pub primary_steps: u32,
     /// Samples toward the sun from each view sample.
     pub light_steps: u32,
+    /// Samples away from the sun from each view sample (the slab model's far side; none for the
+    /// octave model).
+    pub back_steps: u32,
     /// Jittered marches averaged per pixel.
     pub samples_per_pixel: u32,
-    /// Multiple scattering of the sun's light.
+    /// Which model of the sun's multiply scattered light the march uses.
+    pub model: LightingModel,
+    /// The slab model of it.
+    pub slab: SunSlab,
+    /// The octave model of it.
     pub octaves: Octaves,
     /// Single-scattering albedo.
     pub albedo: f32,
@@ -60,14 +73,22 @@ impl MarchSettings {
         let r = &scene.render;
         let (primary, light, spp) = Self::preset(r.quality);
         let l = &scene.lighting;
+        let light_steps = r.light_steps.unwrap_or(light);
+        let phase = PhaseLobes::from_scene(&scene.phase);
         MarchSettings {
             primary_steps: r.primary_steps.unwrap_or(primary),
-            light_steps: r.light_steps.unwrap_or(light),
+            light_steps,
+            back_steps: match l.model {
+                LightingModel::Slab => back_steps(light_steps),
+                LightingModel::Octaves => 0,
+            },
             samples_per_pixel: r.samples_per_pixel.unwrap_or(spp),
+            model: l.model,
+            slab: l.sun_slab(phase),
             octaves: l.octaves(),
             albedo: l.albedo,
             ambient_scale: l.ambient_scale,
-            phase: PhaseLobes::from_scene(&scene.phase),
+            phase,
             empty_space_skipping: r.empty_space_skipping,
         }
     }
@@ -89,9 +110,11 @@ struct MarchUniform {
     ambient_scale: f32,
     empty_space_skipping: u32,
     tile_width: u32,
-    reserved0: u32,
+    lighting_model: u32,
     tile_origin: UVec2,
-    reserved: UVec2,
+    back_steps: u32,
+    reserved: u32,
+    slab_params: Vec4,
 }
 
 impl MarchUniform {
@@ -109,6 +132,12 @@ impl MarchUniform {
             phase_lobes: Vec4::from_array(settings.phase.to_gpu()),
             ambient_scale: settings.ambient_scale,
             empty_space_skipping: settings.empty_space_skipping as u32,
+            lighting_model: match settings.model {
+                LightingModel::Slab => 0,
+                LightingModel::Octaves => 1,
+            },
+            back_steps: settings.back_steps,
+            slab_params: Vec4::from_array(settings.slab.params_to_gpu()),
             ..MarchUniform::zeroed()
         }
     }
@@ -302,9 +331,11 @@ mod tests {
                 ambient_scale,
                 empty_space_skipping,
                 tile_width,
-                reserved0,
+                lighting_model,
                 tile_origin,
+                back_steps,
                 reserved,
+                slab_params,
             }
         );
         assert_wgsl_layout!(

@@ -1,4 +1,4 @@
-#import hiheight frame environment phase
+#import hiheight frame environment phase slab
 // Ray-marched clouds: per output texel, in-scattered radiance, transmittance and distance of the
 // cloud field along the view ray, up to the host's depth buffer (the cloud-output contract,
 // output/mod.rs). No haze: the compositor applies aerial perspective at the cloud distance.
@@ -16,9 +16,11 @@ struct March {
     ambient_scale: f32,         // scale of sky and ground light
     empty_space_skipping: u32,  // 1 to skip empty space with the hi-height pyramid
     tile_width: u32,            // width of the texel band this dispatch covers
-    reserved0: u32,
+    lighting_model: u32,        // 0: slab (optics/slab.rs), 1: octaves
     tile_origin: vec2<u32>,     // first texel of the band
-    reserved: vec2<u32>,
+    back_steps: u32,            // samples away from the sun from each view sample (slab)
+    reserved: u32,
+    slab_params: vec4<f32>,     // SunSlab::params_to_gpu
 }
 
 struct MarchResult {
@@ -60,11 +62,37 @@ fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
     return field_optical_depth_coarse(p, sun, vec3<f32>(0.0, length_m, 2.0), march.light_steps, jitter);
 }
 
-// Light scattered from the sky above and the ground below, per unit sigma_s: the mean diffuse
-// radiance of the two-stream solution for a slab lit by the sky's mean radiance from above and the
-// radiance from below (frame_two_stream_share_from_below), the optical depths to the top and the
-// bottom of the layer estimated from one sample halfway.
-fn march_ambient(p: vec3<f32>, h: f32, light: MarchLight) -> vec3<f32> {
+// Optical depth away from the sun from p, through the coarse density, to where the path leaves the
+// layers (the bottom, or the top when the sun is below the horizon), within the sun path's bounds:
+// the far side of the slab model. `back_steps` doubling segments, as toward the sun.
+fn march_back_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
+    let away = -environment_sun_direction();
+    var length_m = MARCH_SUN_PATH_MAX_M;
+    if field.layer_count > 0u {
+        let below = field_below(p, away, field.layer_bottom_m);
+        let through_top = field_below(p, away, field.layer_top_m).y;
+        let to_bottom = select(through_top, below.x, below.x <= below.y && below.x > 0.0);
+        length_m = clamp(to_bottom, MARCH_SUN_PATH_MIN_M, MARCH_SUN_PATH_MAX_M);
+    }
+    return field_optical_depth_coarse(p, away, vec3<f32>(0.0, length_m, 2.0), march.back_steps, jitter);
+}
+
+// The sun's light scattered at p toward the eye along d, per unit sigma_s and unit irradiance, by
+// the scene's model of multiple scattering, with tau_sun the optical depth toward the sun.
+fn march_sun_scattering(p: vec3<f32>, d: vec3<f32>, tau_sun: f32, jitter: f32) -> f32 {
+    let cos_theta = dot(d, environment_sun_direction());
+    // Both models, chosen by select: lavapipe recompiles (and leaks) a shader that branches on a
+    // uniform alone at every upload. The octave model marches no back samples (back_steps = 0).
+    let slab = SlabModel(march.phase_lobes, march.slab_params);
+    let by_slab = slab_scattering(slab, cos_theta, tau_sun, march_back_optical_depth(p, jitter));
+    let factors = vec3<f32>(march.octave_attenuation, march.octave_contribution, march.octave_eccentricity);
+    let by_octaves = phase_octaves(march.phase_lobes, factors, march.octaves, cos_theta, tau_sun);
+    return select(by_octaves, by_slab, march.lighting_model == 0u);
+}
+
+// The coarse optical depths (up, down) from p at altitude h to the top and the bottom of the
+// layer, each estimated from one sample halfway (500 m each way outside the layers).
+fn march_column(p: vec3<f32>, h: f32) -> vec2<f32> {
     let up = field_up(p);
     var above = 500.0;
     var below = 500.0;
@@ -74,7 +102,14 @@ fn march_ambient(p: vec3<f32>, h: f32, light: MarchLight) -> vec3<f32> {
     }
     let tau_up = field_extinction_coarse(p + up * (0.5 * above)) * above;
     let tau_down = field_extinction_coarse(p - up * (0.5 * below)) * below;
-    let share_from_below = frame_two_stream_share_from_below(tau_up, tau_down);
+    return vec2<f32>(tau_up, tau_down);
+}
+
+// Light scattered from the sky above and the ground below, per unit sigma_s: the mean diffuse
+// radiance of the two-stream solution for a slab lit by the sky's mean radiance from above and the
+// radiance from below (frame_two_stream_share_from_below), with the optical depths of `column`.
+fn march_ambient(column: vec2<f32>, light: MarchLight) -> vec3<f32> {
+    let share_from_below = frame_two_stream_share_from_below(column.x, column.y);
     return march.ambient_scale * mix(light.sky_above, light.from_below, share_from_below);
 }
 
@@ -138,7 +173,6 @@ fn march_first_stratum(t0: f32, t1: f32, n: u32, empty_until: f32) -> u32 {
 // `volume` is the stretch inside voxel-grid boxes.
 fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volume: vec2<f32>) -> MarchResult {
     let n = march_step_count(t1 - t0);
-    let cos_theta = dot(d, environment_sun_direction());
     let albedo = march.albedo;
     var radiance = vec3<f32>(0.0);
     var transmittance = 1.0;
@@ -162,11 +196,10 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
         if sigma_t <= 0.0 {
             continue;
         }
-        let h = field_altitude_m(p);
+        let column = march_column(p, field_altitude_m(p));
         let tau_sun = march_sun_optical_depth(p, jitter);
-        let factors = vec3<f32>(march.octave_attenuation, march.octave_contribution, march.octave_eccentricity);
-        let sun = phase_octaves(march.phase_lobes, factors, march.octaves, cos_theta, tau_sun) * light.sun;
-        let source = albedo * (sun + march_ambient(p, h, light));
+        let sun = march_sun_scattering(p, d, tau_sun, jitter) * light.sun;
+        let source = albedo * (sun + march_ambient(column, light));
         let step_transmittance = exp(-sigma_t * dt);
         radiance += transmittance * source * (1.0 - step_transmittance);
         distance_weighted += transmittance * (1.0 - step_transmittance) * distance(p, o);

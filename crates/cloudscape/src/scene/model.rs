@@ -492,12 +492,33 @@ impl Default for PhaseFunction {
     }
 }
 
+/// How the ray marcher models the sun's light scattered more than once in the clouds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, DocumentedVariants)]
+#[serde(rename_all = "snake_case")]
+pub enum LightingModel {
+    /// The δ-Eddington solution of a slab along the sun, from the optical depths toward the sun
+    /// and away from it (`optics::slab`).
+    Slab,
+    /// Multiple-scattering octaves (Wrenninge 2013), from the optical depth toward the sun.
+    Octaves,
+}
+
 /// Lighting approximations of the real-time techniques (the path tracer needs none of them).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct Lighting {
     /// Single-scattering albedo sigma_s / sigma_t, 0..1; cloud droplets are about 1 (physics.md).
     pub albedo: f32,
+    /// The ray marcher's model of the sun's multiply scattered light.
+    pub model: LightingModel,
+    /// Slab model: scale of its diffuse light, 0..4; below 1 a finite cloud loses light through
+    /// its sides that the infinite slab keeps. The default is fitted to the path tracer on
+    /// generated scenes (`cloudscape fit-lighting --scenes 16 --validation 6 --points 300
+    /// --paths 256`, docs/lighting.md).
+    pub slab_diffuse_scale: f32,
+    /// Slab model: factor of the optical depth to the far side of the layers, 0..4; fitted with
+    /// `slab_diffuse_scale`.
+    pub slab_back_scale: f32,
     /// Multiple-scattering octaves (Wrenninge 2013), 1..8; 1 is single scattering only.
     pub octaves: u32,
     /// Octave extinction factor `a`, 0..1: each octave sees `a^i` of the optical depth to the sun.
@@ -516,6 +537,16 @@ pub struct Lighting {
 }
 
 impl Lighting {
+    /// The slab model these settings describe for `lobes`.
+    pub fn sun_slab(&self, lobes: crate::optics::PhaseLobes) -> crate::optics::SunSlab {
+        crate::optics::SunSlab::new(
+            lobes,
+            self.albedo,
+            self.slab_diffuse_scale,
+            self.slab_back_scale,
+        )
+    }
+
     /// The multiple-scattering octaves these settings describe.
     pub fn octaves(&self) -> crate::optics::Octaves {
         crate::optics::Octaves {
@@ -531,6 +562,9 @@ impl Default for Lighting {
     fn default() -> Self {
         Lighting {
             albedo: 1.0,
+            model: LightingModel::Slab,
+            slab_diffuse_scale: 0.613,
+            slab_back_scale: 1.422,
             octaves: 6,
             octave_attenuation: 0.5,
             octave_contribution: 0.7,

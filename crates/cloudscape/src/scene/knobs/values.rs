@@ -5,8 +5,8 @@ use serde::Serialize;
 
 use super::{Field, FieldMut};
 use crate::scene::model::{
-    ParticleBlending, ParticleStyle, PhaseModel, PlanetShape, Quality, SkyModel, SpriteLod,
-    TableResolution, Technique, Tonemap, WeatherSource,
+    LightingModel, ParticleBlending, ParticleStyle, PhaseModel, PlanetShape, Quality, SkyModel,
+    SpriteLod, TableResolution, Technique, Tonemap, WeatherSource,
 };
 
 /// A type a knob can hold.
@@ -160,6 +160,7 @@ listed! {
     PlanetShape { Spherical, Flat }
     WeatherSource { Procedural, File }
     PhaseModel { Mie, Hg, DualHg }
+    LightingModel { Slab, Octaves }
     ParticleStyle { Smooth, Thresholded, Pyroclastic }
     TableResolution { Low, Standard, High }
     ParticleBlending { VolumeAware, Alpha }
