@@ -40,8 +40,8 @@ enum Command {
     /// Render the canonical scenes with the ray marcher and the path tracer, compare them, and
     /// write `docs/realism.md`.
     Report(report::ReportArgs),
-    /// Fit the ray marcher's multiple-scattering octaves to the path tracer on generated scenes
-    /// (none of them canonical) and score the fit on held-out ones.
+    /// Fit the ray marcher's models of multiple scattering (slab and octaves) to the path tracer
+    /// on generated scenes (none of them canonical) and score the fit on held-out ones.
     FitLighting(fit_lighting::FitLightingArgs),
     /// Render a scene's frames over scene time (camera, sun and coverage paths, wind) to PNG or
     /// EXR files, with an animated GIF preview (and an MP4 when ffmpeg is on PATH).

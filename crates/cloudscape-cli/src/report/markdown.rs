@@ -120,7 +120,7 @@ fn targets_section(s: &mut String, rows: &[Row]) {
     );
     for r in rows {
         let floor = r.noise_floor.flip_mean;
-        let spp = f64::from(r.reference.spp()) * f64::from((floor / FLOOR_TARGET).max(1.0)).powi(2);
+        let spp = spp_for_floor_target(r.reference.spp(), floor);
         let pixels = f64::from(r.reference.width * r.reference.height);
         let hours = spp * pixels / r.reference.samples_per_second().max(1e-9) / 3600.0;
         let _ = writeln!(
@@ -133,17 +133,25 @@ fn targets_section(s: &mut String, rows: &[Row]) {
     }
     let _ = writeln!(
         s,
-        "\nWhy the floors stay above the target: the tracer is unbiased, and what is left is the \
-         variance of rare, bright paths: the sunlit ground seen through gaps and under thin cloud \
-         after several scatterings, and light that leaves the droplets' narrow forward peak toward \
-         the sun's disc. Converging them costs the hours above on this machine's two cores; \
-         the stored references are extended run after run with `--spp`. Why the ray marcher stays \
+        "\nWhy the floors stay above the target: the tracer is unbiased and already weighs three \
+         ways of reaching the sun (its disc, a probe of the droplets' forward peak, the phase-sampled \
+         continuation) and two of reaching the sky by multiple importance sampling; what is left is \
+         the variance of long random walks, in the sunlit tops of thick clouds and on the ground in \
+         their shadows, lit only by light that diffused through them (`docs/lighting.md` measures \
+         where). Converging them costs the hours above on this machine's two cores; the stored \
+         references are extended run after run with `--spp`. Why the ray marcher stays \
          above its target: a comparison with a noisy reference cannot fall far below the floor \
          (the column above the floor is the part the reference resolves), and the rest is the \
          model's: a few coarse samples toward and away from the sun stand for the whole light \
          path, and the slab model's two fitted factors leave a relative RMS of about 1.2 on the \
          sun's multiply scattered light at single points of held-out scenes (`docs/lighting.md`)."
     );
+}
+
+/// Samples per pixel a reference with noise floor `floor` at `spp` needs to reach
+/// [`FLOOR_TARGET`]: noise falls as 1/sqrt(spp), HDR-FLIP of small noise about in proportion.
+fn spp_for_floor_target(spp: u32, floor: f32) -> f64 {
+    f64::from(spp) * f64::from((floor / FLOOR_TARGET).max(1.0)).powi(2)
 }
 
 fn cost_section(s: &mut String, rows: &[Row]) {
@@ -246,5 +254,16 @@ fn images_section(s: &mut String, rows: &[Row]) {
              | ![](realism/{n}-sprites.png) | ![](realism/{n}-reference.png) | ![](realism/{n}-sprites-flip.png) |\n",
             n = r.canonical.name
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_floor_twice_the_target_needs_four_times_the_samples() {
+        assert_eq!(spp_for_floor_target(100, 2.0 * FLOOR_TARGET), 400.0);
+        assert_eq!(spp_for_floor_target(100, 0.5 * FLOOR_TARGET), 100.0);
     }
 }
