@@ -36,9 +36,6 @@ pub struct MarchSettings {
     pub primary_steps: u32,
     /// Samples toward the sun from each view sample.
     pub light_steps: u32,
-    /// Samples away from the sun from each view sample (the slab model's far side; none for the
-    /// octave model).
-    pub back_steps: u32,
     /// Jittered marches averaged per pixel.
     pub samples_per_pixel: u32,
     /// Which model of the sun's multiply scattered light the march uses.
@@ -58,6 +55,15 @@ pub struct MarchSettings {
 }
 
 impl MarchSettings {
+    /// Samples away from the sun from each view sample: the slab model's far side; none for the
+    /// octave model, which does not read it.
+    pub fn back_steps(&self) -> u32 {
+        match self.model {
+            LightingModel::Slab => back_steps(self.light_steps),
+            LightingModel::Octaves => 0,
+        }
+    }
+
     /// Steps of a quality preset: (primary, light, samples per pixel).
     pub fn preset(quality: Quality) -> (u32, u32, u32) {
         match quality {
@@ -78,10 +84,6 @@ impl MarchSettings {
         MarchSettings {
             primary_steps: r.primary_steps.unwrap_or(primary),
             light_steps,
-            back_steps: match l.model {
-                LightingModel::Slab => back_steps(light_steps),
-                LightingModel::Octaves => 0,
-            },
             samples_per_pixel: r.samples_per_pixel.unwrap_or(spp),
             model: l.model,
             slab: l.sun_slab(phase),
@@ -136,7 +138,7 @@ impl MarchUniform {
                 LightingModel::Slab => 0,
                 LightingModel::Octaves => 1,
             },
-            back_steps: settings.back_steps,
+            back_steps: settings.back_steps(),
             slab_params: Vec4::from_array(settings.slab.params_to_gpu()),
             ..MarchUniform::zeroed()
         }
