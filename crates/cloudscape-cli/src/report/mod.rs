@@ -10,6 +10,7 @@ mod chart;
 mod keys;
 mod markdown;
 mod measure;
+mod noise;
 mod particles;
 mod references;
 mod sprites;
@@ -25,6 +26,7 @@ use cloudscape::scene::{SceneDocument, Technique};
 use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer};
 use glam::UVec2;
 use measure::{Measurement, Variant};
+use noise::ReferenceNoise;
 use references::{Budget, Reference, ReferenceStore};
 use std::path::{Path, PathBuf};
 
@@ -43,7 +45,7 @@ pub struct ReportArgs {
     /// Image height in pixels.
     #[arg(long, default_value_t = 90)]
     height: u32,
-    /// Path-traced samples per pixel wanted (half with each of two seeds, for the noise floor):
+    /// Path-traced samples per pixel wanted (half with each of two seeds, for the noise estimate):
     /// stored references with fewer are extended, continuing their samples. Without it the stored
     /// references are used as they are, and a missing or stale one is traced with 256.
     #[arg(long, value_parser = clap::value_parser!(u32).range(2..))]
@@ -71,16 +73,16 @@ pub struct Row {
     canonical: &'static Canonical,
     /// How its reference was traced.
     reference: references::Record,
-    /// The reference's two halves against each other.
-    noise_floor: Comparison,
+    /// The reference's noise.
+    noise: ReferenceNoise,
     /// Every variant's error and warm frame time, ms.
     variants: Vec<(Variant, Comparison, f64)>,
     /// The ray marcher as the scene renders itself.
     raymarch: Comparison,
     /// The particle technique's rows; None where the scene makes no particles.
     particles: Option<particles::ParticleRow>,
-    /// The sprite technique's row.
-    sprites: sprites::SpriteRow,
+    /// The sprite technique's row; None where the sprites show none of the scene's clouds.
+    sprites: Option<sprites::SpriteRow>,
 }
 
 /// Renders, traces and compares every canonical scene, then writes the report and its chart.
@@ -166,7 +168,7 @@ fn scene_row(
     let key = keys::field_key(doc)?;
     let reference = field_reference(canonical.name, doc, (args, store), &key)?;
     let full = reference.image();
-    let noise_floor = Comparison::of(&reference.halves[0], &reference.halves[1], None)?;
+    let noise = ReferenceNoise::of(&reference)?;
     let name = canonical.name;
     let image_path = |kind: &str| images.join(format!("{name}-{kind}.png"));
     let (ev, op) = (doc.scene.render.exposure_ev, doc.scene.render.tonemap);
@@ -178,7 +180,10 @@ fn scene_row(
     };
     let (mut variants, mut raymarch, mut particle_row, mut sprite_row) =
         (Vec::new(), None, None, None);
-    for variant in Variant::all() {
+    for variant in Variant::all()
+        .into_iter()
+        .filter(|v| v.shows_clouds_of(&doc.scene))
+    {
         let mut m: Measurement = measure::measure(doc, ctx, variant, &full)?;
         eprintln!(
             "{:<16} HDR-FLIP {:.4} relMSE {:.4} frame {:.0} ms",
@@ -205,18 +210,18 @@ fn scene_row(
         }
     }
     eprintln!(
-        "noise floor HDR-FLIP {:.4} relMSE {:.4} ({} spp)",
-        noise_floor.flip_mean,
-        noise_floor.relative_mse,
+        "reference noise HDR-FLIP {:.4} (halves against each other {:.4}, {} spp)",
+        noise.own.flip_mean,
+        noise.halves.flip_mean,
         reference.record.spp()
     );
     Ok(Row {
         canonical,
         reference: reference.record,
-        noise_floor,
+        noise,
         variants,
         raymarch: raymarch.context("the ray marcher at the scene's quality was not measured")?,
         particles: particle_row,
-        sprites: sprite_row.context("the sprites were not measured")?,
+        sprites: sprite_row,
     })
 }

@@ -8,6 +8,7 @@
 
 use super::keys::particle_key;
 use super::measure::Measurement;
+use super::noise::ReferenceNoise;
 use super::references::{Budget, Reference, ReferenceStore};
 use crate::compare::Comparison;
 use anyhow::Result;
@@ -30,8 +31,8 @@ pub struct ParticleRow {
     pub shape: Comparison,
     /// Particles generated (the CPU specification's count).
     pub count: usize,
-    /// The path-traced particles' noise floor: their two halves against each other.
-    pub noise_floor: Comparison,
+    /// The path-traced particles' estimated error: their noise ([`ReferenceNoise`]).
+    pub noise: Comparison,
 }
 
 /// Where the particle row finds its references: the store, the budget and the field's key.
@@ -92,7 +93,7 @@ pub fn row(
         lighting: Comparison::of(&traced, &m.rendered.hdr, None)?,
         shape: Comparison::of(field, &traced, None)?,
         count: particles.len(),
-        noise_floor: Comparison::of(&reference.halves[0], &reference.halves[1], None)?,
+        noise: ReferenceNoise::of(&reference)?.own,
     };
     eprintln!(
         "particles: {} made; HDR-FLIP total {:.4}, lighting {:.4}, shape {:.4}",
@@ -116,9 +117,9 @@ pub fn markdown<'a>(
          precomputed tables, the light occlusion and the blending. *Shape* compares the \
          path-traced particles with the path-traced field: the error of turning the field into \
          particles, whatever the lighting. The particle references are stored and extended as the \
-         field's are; their noise floor is their two halves against each other. The particle \
+         field's are; their noise is estimated as the field's is. The particle \
          technique does not turn voxel grids into particles: the voxel scene makes none.\n\n\
-         | scene | particles | total HDR-FLIP | total relMSE | lighting HDR-FLIP | lighting relMSE | shape HDR-FLIP | shape relMSE | noise floor HDR-FLIP |\n\
+         | scene | particles | total HDR-FLIP | total relMSE | lighting HDR-FLIP | lighting relMSE | shape HDR-FLIP | shape relMSE | reference noise HDR-FLIP |\n\
          |---|---|---|---|---|---|---|---|---|"
     );
     for (title, r) in rows {
@@ -136,7 +137,7 @@ pub fn markdown<'a>(
             r.lighting.relative_mse,
             r.shape.flip_mean,
             r.shape.relative_mse,
-            r.noise_floor.flip_mean
+            r.noise.flip_mean
         );
     }
 }

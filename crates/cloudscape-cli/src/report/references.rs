@@ -71,9 +71,17 @@ pub struct Reference {
 impl Reference {
     /// The mean of both halves: the reference itself.
     pub fn image(&self) -> HdrImage {
+        let [wa, wb] = self
+            .record
+            .halves
+            .map(|h| h.spp as f32 / self.record.spp().max(1) as f32);
+        self.combination(wa, wb)
+    }
+
+    /// The pixel-wise sum `wa * first half + wb * second half`.
+    pub fn combination(&self, wa: f32, wb: f32) -> HdrImage {
         let [a, b] = &self.halves;
-        let (wa, wb) = (self.record.halves[0].spp, self.record.halves[1].spp);
-        weighted_mean((a, wa), (b, wb))
+        linear_combination((a, wa), (b, wb))
     }
 }
 
@@ -229,7 +237,11 @@ fn extend<M: Medium>(
         render.run_pass(PASS_SPP.min(spp - record.spp - added), &|| false, &|_| {});
         added += PASS_SPP.min(spp - record.spp - added);
     }
-    let image = weighted_mean((&mean, record.spp), (&render.image(), added));
+    let total = (record.spp + added).max(1) as f32;
+    let image = linear_combination(
+        (&mean, record.spp as f32 / total),
+        (&render.image(), added as f32 / total),
+    );
     let record = HalfRecord {
         spp: record.spp + added,
         seconds: record.seconds + render.stats().elapsed.as_secs_f64(),
@@ -238,10 +250,8 @@ fn extend<M: Medium>(
     (image, record)
 }
 
-/// The pixel-wise mean of two images of one size, weighted by their sample counts.
-fn weighted_mean((a, wa): (&HdrImage, u32), (b, wb): (&HdrImage, u32)) -> HdrImage {
-    let total = (wa + wb).max(1) as f32;
-    let (wa, wb) = (wa as f32 / total, wb as f32 / total);
+/// The pixel-wise sum `wa a + wb b` of two images of one size.
+fn linear_combination((a, wa): (&HdrImage, f32), (b, wb): (&HdrImage, f32)) -> HdrImage {
     let pixels = a
         .pixels
         .iter()

@@ -48,7 +48,7 @@ pub fn row(
 }
 
 /// The sprite section of the report: one row per scene.
-pub fn markdown<'a>(s: &mut String, rows: impl Iterator<Item = (&'a str, &'a SpriteRow)>) {
+pub fn markdown<'a>(s: &mut String, rows: impl Iterator<Item = (&'a str, &'a Option<SpriteRow>)>) {
     let _ = writeln!(
         s,
         "\n## Sprites\n\n\
@@ -56,12 +56,16 @@ pub fn markdown<'a>(s: &mut String, rows: impl Iterator<Item = (&'a str, &'a Spr
          against the same path-traced field. Its clouds are the field's (clusters of textured \
          sprites in wind-borne tiles, opacity ramping with the field's density) and hand-made or \
          model-file clouds; its shading is Wang's artist model with physically derived numbers \
-         (`docs/sprites.md`). It draws no voxel grids: the voxel scene shows none.\n\n\
+         (`docs/sprites.md`). It draws no voxel grids: the voxel scene shows none, and is not measured.\n\n\
          The first frame's wall time includes making the field's sprite clouds on the CPU.\n\n\
          | scene | sprites drawn | HDR-FLIP | relMSE | luminance ratio | first frame ms |\n\
          |---|---|---|---|---|---|"
     );
     for (title, r) in rows {
+        let Some(r) = r else {
+            let _ = writeln!(s, "| {title} | 0 | | | | |");
+            continue;
+        };
         let c = &r.total;
         let _ = writeln!(
             s,
