@@ -3,7 +3,7 @@
 //! tracing.
 //!
 //! Per canonical scene and medium (the cloud field, or the particle technique's particles) a
-//! reference is two halves traced with two seeds, whose disagreement is the noise floor. Each half
+//! reference is two halves traced with two seeds, whose disagreement measures its noise. Each half
 //! is stored as the mean radiance over its samples (`NAME-0.exr`, `NAME-1.exr`, 32-bit float) and
 //! described in `NAME.json`: the key of everything the path tracer read, the samples per pixel,
 //! the seeds and the tracing time. A stored reference whose key differs is stale and traced anew;
