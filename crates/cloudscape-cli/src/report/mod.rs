@@ -168,7 +168,7 @@ fn scene_row(
     let key = keys::field_key(doc)?;
     let reference = field_reference(canonical.name, doc, (args, store), &key)?;
     let full = reference.image();
-    let noise = ReferenceNoise::of(&reference)?;
+    let noise = ReferenceNoise::of(&reference, &full)?;
     let name = canonical.name;
     let image_path = |kind: &str| images.join(format!("{name}-{kind}.png"));
     let (ev, op) = (doc.scene.render.exposure_ev, doc.scene.render.tonemap);

@@ -32,15 +32,12 @@ pub struct ReferenceNoise {
 }
 
 impl ReferenceNoise {
-    /// Measures `reference`'s noise.
-    pub fn of(reference: &Reference) -> Result<ReferenceNoise> {
-        let image = reference.image();
-        let against =
-            |amplitude| Comparison::of(&image, &with_own_noise(reference, amplitude), None);
+    /// Measures `reference`'s noise; `image` is the reference itself ([`Reference::image`]).
+    pub fn of(reference: &Reference, image: &HdrImage) -> Result<ReferenceNoise> {
         Ok(ReferenceNoise {
             halves: Comparison::of(&reference.halves[0], &reference.halves[1], None)?,
-            own: against(1.0)?,
-            with_four_times_the_samples: against(0.5)?,
+            own: against_own_noise(reference, image, 1.0)?,
+            with_four_times_the_samples: against_own_noise(reference, image, 0.5)?,
         })
     }
 
@@ -59,6 +56,21 @@ impl ReferenceNoise {
     pub fn spp_for(&self, spp: u32, target: f32) -> f64 {
         spp_for(spp, self.own.flip_mean, target, self.flip_exponent())
     }
+}
+
+/// The reference's estimated error alone ([`ReferenceNoise::own`]), where the other two figures are
+/// not wanted; `image` is the reference itself.
+pub fn own_error(reference: &Reference, image: &HdrImage) -> Result<Comparison> {
+    against_own_noise(reference, image, 1.0)
+}
+
+/// `image`, the reference, against itself plus `amplitude` times noise of its own size.
+fn against_own_noise(
+    reference: &Reference,
+    image: &HdrImage,
+    amplitude: f32,
+) -> Result<Comparison> {
+    Comparison::of(image, &with_own_noise(reference, amplitude), None)
 }
 
 /// The reference plus `amplitude` times noise of its own size: `R + amplitude D sqrt(n0 n1) / N`.

@@ -8,7 +8,7 @@
 
 use super::keys::particle_key;
 use super::measure::Measurement;
-use super::noise::ReferenceNoise;
+use super::noise;
 use super::references::{Budget, Reference, ReferenceStore};
 use crate::compare::Comparison;
 use anyhow::Result;
@@ -31,7 +31,7 @@ pub struct ParticleRow {
     pub shape: Comparison,
     /// Particles generated (the CPU specification's count).
     pub count: usize,
-    /// The path-traced particles' estimated error: their noise ([`ReferenceNoise`]).
+    /// The path-traced particles' estimated error: their noise ([`noise::own_error`]).
     pub noise: Comparison,
 }
 
@@ -93,7 +93,7 @@ pub fn row(
         lighting: Comparison::of(&traced, &m.rendered.hdr, None)?,
         shape: Comparison::of(field, &traced, None)?,
         count: particles.len(),
-        noise: ReferenceNoise::of(&reference)?.own,
+        noise: noise::own_error(&reference, &traced)?,
     };
     eprintln!(
         "particles: {} made; HDR-FLIP total {:.4}, lighting {:.4}, shape {:.4}",
