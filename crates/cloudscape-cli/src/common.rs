@@ -44,11 +44,21 @@ impl SceneArgs {
         overrides
     }
 
-    /// Loads and validates the scene with every override applied, then `extra`.
+    /// Loads and validates the scene with every override applied, then `extra`, and prints on
+    /// stderr what the overrides replaced without naming it.
     pub fn load(&self, extra: &[String]) -> Result<SceneDocument> {
         let mut overrides = self.all_overrides();
         overrides.extend_from_slice(extra);
-        Ok(SceneDocument::load(self.scene.as_deref(), &overrides)?)
+        let document = SceneDocument::load(self.scene.as_deref(), &overrides)?;
+        print_notes(&document);
+        Ok(document)
+    }
+}
+
+/// Prints each of the document's notes (what its overrides replaced) as one line on stderr.
+pub fn print_notes(document: &SceneDocument) {
+    for note in document.notes() {
+        eprintln!("note: {note}");
     }
 }
 

@@ -252,6 +252,41 @@ fn layers_and_visibility_are_given_by_the_report_or_the_file_not_both() {
 }
 
 #[test]
+fn a_report_from_the_command_line_replaces_the_files_layers_and_visibility() {
+    let report = "EGLL 011750Z 24012KT 9999 FEW012 SCT030 BKN045 18/12 Q1012";
+    let overrides = [format!("weather.metar={report}")];
+    let document = SceneDocument::load(None, &overrides).expect("the command line wins");
+    assert_eq!(document.scene.layers, metar_scene(report).layers);
+    assert_eq!(
+        document.notes(),
+        ["--set weather.metar replaces the scene's layers and sky.visibility_m"]
+    );
+    let text = "[[layers]]\ncoverage = 0.3\n";
+    let document = SceneDocument::parse(text, "scene.toml", Path::new("."), &overrides).unwrap();
+    assert_eq!(document.scene.layers.len(), 3);
+    assert_eq!(
+        document.notes(),
+        ["--set weather.metar replaces the scene's layers"]
+    );
+    let later = [overrides[0].clone(), "layers.0.coverage=0.3".to_string()];
+    let error = SceneDocument::load(None, &later).unwrap_err();
+    assert!(error.message.contains("keep one"), "{error}");
+    assert!(SceneDocument::load(None, &[]).unwrap().notes().is_empty());
+}
+
+#[test]
+fn a_time_of_day_from_the_command_line_replaces_the_files_sun_angles() {
+    let text = "[sun]\nelevation_deg = 40.0\n";
+    let overrides = ["sun.time_of_day={ solar_time_h = 9.0, latitude_deg = 48.0, day_of_year = 172 }".to_string()];
+    let document = SceneDocument::parse(text, "scene.toml", Path::new("."), &overrides).unwrap();
+    assert_ne!(document.scene.sun.elevation_deg, 40.0);
+    assert_eq!(
+        document.notes(),
+        ["--set sun.time_of_day replaces the scene's sun.elevation_deg"]
+    );
+}
+
+#[test]
 fn the_sun_is_given_by_time_of_day_or_by_angles_not_both() {
     let text = "[sun]\ntime_of_day = { solar_time_h = 12.0, latitude_deg = 51.5, day_of_year = 172 }\nelevation_deg = 40.0\n";
     assert_rejected(

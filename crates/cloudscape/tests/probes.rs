@@ -377,7 +377,7 @@ fn atmosphere_functions_match_the_cpu() {
             )
         })
         .collect();
-    let probe = (&ctx, &clouds);
+    let probe = (&*ctx, &clouds);
     assert_points(
         probe,
         ProbeFunction::SunIrradiance,
@@ -461,7 +461,7 @@ fn the_cloud_shadow_map_matches_the_cpu() {
             )
         })
         .collect();
-    let probe = (&ctx, &clouds);
+    let probe = (&*ctx, &clouds);
     let sun_depth = |p| Vec3::splat(map.optical_depth(p, 0));
     assert_points(
         probe,

@@ -42,6 +42,7 @@ impl LiveScene {
     /// Loads the scene `path` (the embedded default when None) with `overrides`.
     pub fn load(path: Option<&Path>, overrides: &[String]) -> Result<LiveScene> {
         let document = SceneDocument::load(path, overrides)?;
+        crate::common::print_notes(&document);
         Ok(LiveScene {
             path: path.map(Path::to_path_buf),
             overrides: overrides.to_vec(),

@@ -63,6 +63,21 @@ fn render_writes_a_png_of_the_requested_size() {
     );
 }
 
+/// The command line is the user's latest word: a METAR report replaces the default scene's layers
+/// (which a file giving both would have to choose between), and the render says so.
+#[test]
+fn a_metar_report_from_the_command_line_replaces_the_scenes_layers() {
+    let scratch = Scratch::new("render-metar");
+    let report = "weather.metar=\"EGLL 011750Z 24012KT 9999 FEW012 SCT030 BKN045 18/12 Q1012\"";
+    let mut args = vec!["render", "--set", report];
+    args.extend(TINY);
+    let run = cloudscape(scratch.path(), &args, true);
+    assert!(run.success, "{}", run.stderr);
+    let note = "note: --set weather.metar replaces the scene's layers and sky.visibility_m";
+    assert!(run.stderr.contains(note), "{}", run.stderr);
+    assert!(scratch.join("cloudscape.png").exists(), "{}", run.stderr);
+}
+
 #[test]
 fn render_exr_holds_finite_non_negative_radiance() {
     let scratch = Scratch::new("render-exr");

@@ -8,6 +8,7 @@ use std::process::{Command, ExitStatus, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
+use crate::needs;
 use crate::support::{Scratch, TINY, cloudscape, command, run};
 use cloudscape::image::HdrImage;
 
@@ -49,14 +50,13 @@ fn interrupt_after(dir: &Path, args: &[&str], cue: &'static str) -> (ExitStatus,
         text
     });
     let seen = cue_seen.recv_timeout(CUE_TIMEOUT);
-    let killed = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .expect("run kill");
+    let pid = libc::pid_t::try_from(child.id()).expect("a process id");
+    // SAFETY: kill(2) takes plain integers; the child is ours and has not been waited for.
+    let killed = unsafe { libc::kill(pid, libc::SIGINT) } == 0;
     let status = child.wait().expect("wait for cloudscape");
     let stderr = reader.join().expect("stderr reader");
     assert!(seen.is_ok(), "never printed {cue:?}:\n{stderr}");
-    assert!(killed.success());
+    assert!(killed, "SIGINT not sent: {}", std::io::Error::last_os_error());
     (status, stderr)
 }
 
@@ -97,20 +97,25 @@ fn an_unwritable_output_path_is_named_and_nothing_is_written() {
     assert!(scratch.file_names().is_empty());
 }
 
-/// A tmpfs of a few kilobytes mounted on a scratch directory, unmounted when dropped. Mounting
-/// needs root, as CI runs.
+/// A tmpfs of a few kilobytes mounted on a scratch directory, unmounted when dropped.
 struct TinyDisk(Scratch);
 
 impl TinyDisk {
-    fn mount(size_kib: u32) -> TinyDisk {
+    /// Mounts it; None, reported by [`needs::met`], when the machine will not (mounting a tmpfs
+    /// needs Linux and root, as CI has).
+    fn mount(size_kib: u32) -> Option<TinyDisk> {
         let scratch = Scratch::new("full-disk");
-        let status = Command::new("mount")
+        let mounted = Command::new("mount")
             .args(["-t", "tmpfs", "-o", &format!("size={size_kib}k"), "tmpfs"])
             .arg(scratch.path())
+            .stderr(Stdio::null())
             .status()
-            .expect("run mount");
-        assert!(status.success(), "mounting a tmpfs needs root (as in CI)");
-        TinyDisk(scratch)
+            .is_ok_and(|status| status.success());
+        let missing = (!mounted).then(|| needs::Missing {
+            what: "a tmpfs mount of its own".to_string(),
+            remedy: "Linux and root, as in CI".to_string(),
+        });
+        needs::met(missing).then_some(TinyDisk(scratch))
     }
 }
 
@@ -122,7 +127,9 @@ impl Drop for TinyDisk {
 
 #[test]
 fn a_full_disk_is_reported_and_leaves_no_partial_file() {
-    let disk = TinyDisk::mount(4);
+    let Some(disk) = TinyDisk::mount(4) else {
+        return;
+    };
     let out = disk.0.join("out.exr");
     let out = out.to_str().expect("a UTF-8 path");
     let args = args(&["render"], &[&TINY, &["--out", out]]);

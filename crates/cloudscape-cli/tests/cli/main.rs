@@ -8,10 +8,14 @@
 mod animate;
 mod bake;
 mod commands;
+#[cfg(unix)]
 mod faults;
+mod needs;
 mod reference;
 mod support;
+#[cfg(unix)]
 mod view;
+#[cfg(unix)]
 mod xvfb;
 
 /// FLIP against goldens in `tests/golden/`, shared with the library's golden tests.

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicU32, Ordering};
 
-use cloudscape::gpu::context::TEST_BACKEND_ENV;
+use cloudscape::gpu::TEST_BACKEND_ENV;
 
 /// Arguments that keep a render small and fast.
 pub const TINY: [&str; 6] = [

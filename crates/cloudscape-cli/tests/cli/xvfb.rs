@@ -4,6 +4,20 @@
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
 
+use crate::needs;
+
+/// The X client libraries winit loads at run time (through x11-dl and xkbcommon-dl), with the
+/// Debian packages that bring them.
+const X_CLIENT_LIBRARIES: [(&str, &str); 7] = [
+    ("libX11.so.6", "libx11-6"),
+    ("libX11-xcb.so.1", "libx11-xcb1"),
+    ("libXcursor.so.1", "libxcursor1"),
+    ("libXi.so.6", "libxi6"),
+    ("libXrandr.so.2", "libxrandr2"),
+    ("libxkbcommon.so.0", "libxkbcommon0"),
+    ("libxkbcommon-x11.so.0", "libxkbcommon-x11-0"),
+];
+
 /// A running Xvfb, stopped when dropped.
 pub struct Xvfb {
     child: Child,
@@ -12,11 +26,17 @@ pub struct Xvfb {
 }
 
 impl Xvfb {
-    /// Starts Xvfb on a free display (it picks one and writes its number to `-displayfd`).
+    /// Starts Xvfb on a free display (it picks one and writes its number to `-displayfd`); None,
+    /// reported by [`needs::met`], when the machine lacks Xvfb or the X client libraries.
     ///
     /// # Panics
-    /// When Xvfb cannot start: the viewer's tests never skip.
-    pub fn start() -> Xvfb {
+    /// When Xvfb is there but cannot start, or with `CI=true` when it is missing.
+    pub fn start() -> Option<Xvfb> {
+        let present = needs::met(needs::program("Xvfb", "xvfb"))
+            && needs::met(needs::libraries(&X_CLIENT_LIBRARIES));
+        if !present {
+            return None;
+        }
         let mut child = Command::new("Xvfb")
             .args([
                 "-displayfd",
@@ -43,10 +63,10 @@ impl Xvfb {
             !number.is_empty() && number.chars().all(|c| c.is_ascii_digit()),
             "Xvfb gave no display number (got {line:?})"
         );
-        Xvfb {
+        Some(Xvfb {
             display: format!(":{number}"),
             child,
-        }
+        })
     }
 }
 

@@ -7,14 +7,10 @@
 
 use std::fmt;
 use std::str::FromStr;
-use std::sync::OnceLock;
 
 /// What to install when no adapter exists; part of every [`GpuError::NoAdapter`] message.
 const INSTALL_HINT: &str = "On Debian/Ubuntu: apt-get install mesa-vulkan-drivers libvulkan1 \
      (software Vulkan) or a GPU driver; or pass --backend gl to use OpenGL (llvmpipe via EGL)";
-
-/// Environment variable that picks the backend of [`GpuContext::for_tests`] (`vulkan` or `gl`).
-pub const TEST_BACKEND_ENV: &str = "CLOUDSCAPE_TEST_BACKEND";
 
 /// A graphics API that wgpu can run on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -287,25 +283,6 @@ impl GpuContext {
             .poll(wgpu::PollType::wait_indefinitely())
             .unwrap_or_else(|error| panic!("the GPU device was lost: {error}"));
     }
-
-    /// The shared context of GPU tests.
-    ///
-    /// Honours the environment variable [`TEST_BACKEND_ENV`] (`vulkan` or `gl`); without it any
-    /// backend is allowed. All callers in one process share one device, and the adapter used is
-    /// printed once to stderr.
-    ///
-    /// # Panics
-    /// When the variable holds an unknown backend or no adapter exists: GPU tests never skip silently.
-    pub fn for_tests() -> GpuContext {
-        static SHARED: OnceLock<GpuContext> = OnceLock::new();
-        SHARED
-            .get_or_init(|| {
-                let context = Self::new(&test_options()).unwrap_or_else(|error| panic!("{error}"));
-                eprintln!("cloudscape GPU tests run on {}", context.summary());
-                context
-            })
-            .clone()
-    }
 }
 
 /// An instance of `backends`, with wgpu's debugging flags from the environment.
@@ -331,20 +308,6 @@ fn all_backends() -> wgpu::Backends {
         .fold(wgpu::Backends::empty(), |all, backend| {
             all | backend.to_wgpu()
         })
-}
-
-fn test_options() -> GpuOptions {
-    let backend = std::env::var(TEST_BACKEND_ENV)
-        .ok()
-        .filter(|text| !text.trim().is_empty());
-    let backend = backend.map(|text| {
-        text.parse::<Backend>()
-            .unwrap_or_else(|error| panic!("{TEST_BACKEND_ENV}: {error}"))
-    });
-    GpuOptions {
-        backend,
-        adapter_substring: None,
-    }
 }
 
 fn describe(info: &wgpu::AdapterInfo) -> String {

@@ -4,14 +4,17 @@
 //! - [`readback`]: copying textures and buffers back to the CPU.
 //! - [`timing`]: per-pass GPU time from timestamp queries.
 //! - [`memory`]: the memory and live objects wgpu reports, for leak checks.
+//! - [`test_gpu`]: the device GPU tests share, taken in turns on OpenGL.
 //! - [`pipeline`]: compute and raster pipeline builders; [`uniform`]: a uniform in its own group.
 
 pub mod context;
 pub mod memory;
 pub mod readback;
+pub mod test_gpu;
 pub mod timing;
 
 pub use context::{Backend, GpuContext, GpuError, GpuOptions};
+pub use test_gpu::{TEST_BACKEND_ENV, TestGpu};
 pub use memory::GpuMemoryReport;
 pub use readback::{read_buffer, read_texture, read_texture_rgba16f, read_texture_rgba32f};
 pub use timing::PassTimer;

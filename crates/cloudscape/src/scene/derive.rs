@@ -12,6 +12,23 @@ use super::{Scene, SceneError, load, locate};
 use crate::animation::solar_position;
 use crate::field::MAX_LAYERS;
 
+/// Each value a scene derives others from, and the keys it derives: a document gives one or the
+/// other, and a `--set` of the source replaces what the file gave of them
+/// ([`super::overrides`]).
+pub(super) const DERIVED: [(&str, &[&str]); 2] = [
+    ("sun.time_of_day", &["sun.elevation_deg", "sun.azimuth_deg"]),
+    ("weather.metar", &["layers", "sky.visibility_m"]),
+];
+
+/// The keys derived from `source`, one of [`DERIVED`]'s sources.
+fn derived_from(source: &str) -> &'static [&'static str] {
+    DERIVED
+        .iter()
+        .find(|(name, _)| *name == source)
+        .map(|(_, derived)| *derived)
+        .expect("a source listed in DERIVED")
+}
+
 /// Fills in the values `scene` derives from `weather.metar` and `sun.time_of_day`; `root` is the
 /// merged document the scene came from, for locating errors.
 pub(super) fn derive(
@@ -20,21 +37,11 @@ pub(super) fn derive(
     sources: &SourceMap,
 ) -> Result<(), SceneError> {
     if let Some(time) = &scene.sun.time_of_day {
-        keep_one(
-            root,
-            sources,
-            "sun.time_of_day",
-            &["sun.elevation_deg", "sun.azimuth_deg"],
-        )?;
+        keep_one(root, sources, "sun.time_of_day")?;
         solar_position(time).apply_to(&mut scene.sun);
     }
     if let Some(report) = &scene.weather.metar {
-        keep_one(
-            root,
-            sources,
-            "weather.metar",
-            &["layers", "sky.visibility_m"],
-        )?;
+        keep_one(root, sources, "weather.metar")?;
         let weather = read_metar(report, root, sources)?;
         if weather.layers.len() > MAX_LAYERS {
             return Err(load::error_at(
@@ -57,12 +64,8 @@ pub(super) fn derive(
 }
 
 /// An error at the first of `derived` the document gives, which `source` already sets.
-fn keep_one(
-    root: &DeTable<'_>,
-    sources: &SourceMap,
-    source: &str,
-    derived: &[&str],
-) -> Result<(), SceneError> {
+fn keep_one(root: &DeTable<'_>, sources: &SourceMap, source: &str) -> Result<(), SceneError> {
+    let derived = derived_from(source);
     let Some(given) = derived
         .iter()
         .find(|key| locate::given_span(root, &key.split('.').collect::<Vec<_>>()).is_some())

@@ -13,12 +13,13 @@ use super::{Scene, SceneError, derive, key_path, locate, overrides, validate};
 /// Builds the scene described by `sources`: the file with its overrides applied, checked, and
 /// the values it derives from others (layers from a METAR report, the sun from the time of day)
 /// filled in.
-pub(super) fn scene(sources: &SourceMap) -> Result<Scene, SceneError> {
-    let root = merged_document(sources)?;
+/// Also returns the notes of what the overrides replaced without naming it.
+pub(super) fn scene(sources: &SourceMap) -> Result<(Scene, Vec<String>), SceneError> {
+    let (root, notes) = document_with_notes(sources)?;
     let mut scene: Scene = deserialize(&root, sources)?;
     validate::validate(&scene).map_err(|v| error_at(Some(&root), sources, &v.key, v.message))?;
     derive::derive(&mut scene, &root, sources)?;
-    Ok(scene)
+    Ok((scene, notes))
 }
 
 /// Builds the `T` that `sources` describe, checked by `check` (which names the dotted key of the
@@ -35,9 +36,14 @@ pub(super) fn document<T: DeserializeOwned>(
 
 /// The file's document with every override applied; spans index the address space of `sources`.
 pub(super) fn merged_document(sources: &SourceMap) -> Result<DeTable<'_>, SceneError> {
+    document_with_notes(sources).map(|(root, _)| root)
+}
+
+/// [`merged_document`], with the notes of what the overrides replaced without naming it.
+fn document_with_notes(sources: &SourceMap) -> Result<(DeTable<'_>, Vec<String>), SceneError> {
     let mut root = parse_file(sources)?;
-    overrides::apply_all(&mut root, sources)?;
-    Ok(root)
+    let notes = overrides::apply_all(&mut root, sources)?;
+    Ok((root, notes))
 }
 
 /// An error about the value at `key` (a dotted key path), located in `root` when the key (or the

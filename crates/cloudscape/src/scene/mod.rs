@@ -51,6 +51,8 @@ pub struct SceneDocument {
     sources: SourceMap,
     /// Directory that relative paths in the scene resolve against.
     base_dir: PathBuf,
+    /// What the overrides replaced without naming it, one line each.
+    notes: Vec<String>,
 }
 
 impl SceneDocument {
@@ -92,12 +94,20 @@ impl SceneDocument {
         overrides: &[String],
     ) -> Result<SceneDocument, SceneError> {
         let sources = SourceMap::new(origin, text, overrides);
-        let scene = load::scene(&sources)?;
+        let (scene, notes) = load::scene(&sources)?;
         Ok(SceneDocument {
             scene,
             sources,
             base_dir: base_dir.to_path_buf(),
+            notes,
         })
+    }
+
+    /// What the overrides replaced without naming it, one line each, for the user to see: a
+    /// `--set weather.metar=...` replaces the file's `layers` and `sky.visibility_m`, a
+    /// `--set sun.time_of_day...` its sun angles.
+    pub fn notes(&self) -> &[String] {
+        &self.notes
     }
 
     /// An error about the value at a dotted key path (`render.width`, `layers.0.coverage`, or

@@ -4,6 +4,10 @@
 //! taken as a string (`render.output=out.png`). Missing tables on the path are created; an index into
 //! an array the file lacks takes that array from the embedded default scene (so `layers.0.coverage`
 //! works on a file without `[[layers]]`).
+//!
+//! The command line is the user's latest word: an override of a value others derive from
+//! (`weather.metar`, `sun.time_of_day`) replaces what came before it of the values it derives
+//! (the file's `layers` and `sky.visibility_m`, its sun angles), and says so in a note.
 
 use std::borrow::Cow;
 use std::ops::Range;
@@ -12,23 +16,58 @@ use toml::Spanned;
 use toml::de::{DeArray, DeTable, DeValue};
 use toml::map::Entry;
 
+use super::derive::DERIVED;
 use super::source_map::SourceMap;
 use super::{DEFAULT_SCENE_TOML, SceneError, key_path};
 
-/// Applies every override of `sources`, in order, to `root`.
+/// Applies every override of `sources`, in order, to `root`. Returns a note, one line each, for
+/// every value an override replaced without naming it (see the module documentation).
 pub(super) fn apply_all<'a>(
     root: &mut DeTable<'a>,
     sources: &'a SourceMap,
-) -> Result<(), SceneError> {
+) -> Result<Vec<String>, SceneError> {
+    let mut notes = Vec::new();
     for (index, (text, start)) in sources.overrides().enumerate() {
         let parsed = Override::parse(text, start)
             .map_err(|message| sources.override_error(index, None, message))?;
         let key = key_path::join(&parsed.path);
+        notes.extend(replace_derived(root, &key));
         parsed
             .apply(root)
             .map_err(|message| sources.override_error(index, Some(key), message))?;
     }
-    Ok(())
+    Ok(notes)
+}
+
+/// When `key` sets (part of) a value that others derive from, removes those others from `root`
+/// and names them; else nothing.
+fn replace_derived(root: &mut DeTable<'_>, key: &str) -> Option<String> {
+    let (source, derived) = DERIVED.iter().find(|(source, _)| {
+        key == *source || key.strip_prefix(source).is_some_and(|rest| rest.starts_with('.'))
+    })?;
+    let removed: Vec<&str> = derived
+        .iter()
+        .copied()
+        .filter(|path| remove_path(root, &path.split('.').collect::<Vec<_>>()))
+        .collect();
+    (!removed.is_empty()).then(|| {
+        format!(
+            "--set {source} replaces the scene's {}",
+            removed.join(" and ")
+        )
+    })
+}
+
+/// Removes the value at `path` (table keys only) from `table`; whether there was one.
+fn remove_path(table: &mut DeTable<'_>, path: &[&str]) -> bool {
+    match path {
+        [] => false,
+        [last] => table.remove(*last).is_some(),
+        [first, rest @ ..] => match table.get_mut(*first).map(Spanned::get_mut) {
+            Some(DeValue::Table(child)) => remove_path(child, rest),
+            _ => false,
+        },
+    }
 }
 
 /// One parsed `key.path=value`, its spans in the shared address space of [`SourceMap`].
