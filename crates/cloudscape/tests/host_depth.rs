@@ -19,17 +19,22 @@ fn overcast(technique: Technique) -> Scene {
     scene
 }
 
-/// The default scene's renderer, begun on a frame of `convention` at 64x36.
-fn begun(
+/// The default scene's renderer for `technique`.
+fn renderer(ctx: &GpuContext, technique: Technique) -> CloudRenderer {
+    CloudRenderer::new(ctx, &overcast(technique), std::path::Path::new(".")).expect("field")
+}
+
+/// Begins a frame of `convention` at 64x36 on `clouds`, which draws `technique`.
+fn begin(
     ctx: &GpuContext,
+    clouds: &mut CloudRenderer,
     convention: DepthConvention,
     technique: Technique,
-) -> (CloudRenderer, Frame) {
+) -> Frame {
     let scene = overcast(technique);
     let frame = Frame::from_scene(&scene, UVec2::new(64, 36)).with_depth(&scene, convention);
-    let mut clouds = CloudRenderer::new(ctx, &scene, std::path::Path::new(".")).expect("field");
     clouds.begin_frame(ctx, &scene, &frame, Reuse::None);
-    (clouds, frame)
+    frame
 }
 
 /// A depth buffer of `size` cleared to `depth`, recorded into `encoder`.
@@ -52,43 +57,50 @@ fn depth_buffer(
     view
 }
 
-/// Renders the default scene with `technique` over a depth buffer of `convention` cleared to the
-/// depth of a wall `wall_m` away (None: no geometry); returns the full-resolution output's (rgb
-/// radiance sum, mean transmittance), upsampled where the technique renders a coarser grid.
+/// Renders the default scene with `technique` (on `clouds`, its renderer) over a depth buffer of
+/// `convention` cleared to the depth of a wall `wall_m` away (None: no geometry); returns the
+/// full-resolution output's (rgb radiance sum, mean transmittance), upsampled where the technique
+/// renders a coarser grid.
 fn clouds_over_depth(
+    ctx: &GpuContext,
+    clouds: &mut CloudRenderer,
     convention: DepthConvention,
     wall_m: Option<f32>,
     technique: Technique,
 ) -> (f32, f32) {
-    let ctx = GpuContext::for_tests();
-    let (mut clouds, frame) = begun(&ctx, convention, technique);
+    let frame = begin(ctx, clouds, convention, technique);
     let depth = wall_m.map_or(convention.far_value(), |d| {
         convention.depth_of_distance(&frame.clip_from_view, d)
     });
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    let depth_view = depth_buffer(&ctx, &mut encoder, frame.size, depth);
-    clouds.encode_clouds(&ctx, &mut encoder, &depth_view, None, None);
-    let color = host_colour(&ctx, frame.size);
+    let depth_view = depth_buffer(ctx, &mut encoder, frame.size, depth);
+    clouds.encode_clouds(ctx, &mut encoder, &depth_view, None, None);
+    let color = host_colour(ctx, frame.size);
     let background = cloudscape::post::Background {
         color: &color,
         depth: &depth_view,
     };
-    clouds.encode_finish(&ctx, &mut encoder, &overcast(technique), &background, None);
+    clouds.encode_finish(ctx, &mut encoder, &overcast(technique), &background, None);
     ctx.queue.submit([encoder.finish()]);
-    let pixels = read_texture_rgba16f(&ctx, clouds.images().clouds.radiance_texture());
+    let pixels = read_texture_rgba16f(ctx, clouds.images().clouds.radiance_texture());
     let radiance: f32 = pixels.iter().map(|p| p[0] + p[1] + p[2]).sum();
     let transmittance = pixels.iter().map(|p| p[3]).sum::<f32>() / pixels.len() as f32;
     (radiance, transmittance)
 }
 
 /// Geometry 500 m away hides all of the layer, which starts 1500 m up; an empty depth buffer
-/// shows it.
+/// shows it. One renderer draws every frame, as a host's does when its depth convention changes.
 fn geometry_hides_the_clouds(technique: Technique, max_clear_transmittance: f32) {
+    let ctx = GpuContext::for_tests();
+    let mut clouds = renderer(&ctx, technique);
     for convention in DepthConvention::ALL {
-        let (radiance, transmittance) = clouds_over_depth(convention, Some(500.0), technique);
+        let draw = |clouds: &mut CloudRenderer, wall_m| {
+            clouds_over_depth(&ctx, clouds, convention, wall_m, technique)
+        };
+        let (radiance, transmittance) = draw(&mut clouds, Some(500.0));
         assert_eq!(radiance, 0.0, "{technique:?} {convention:?}");
         assert_eq!(transmittance, 1.0, "{technique:?} {convention:?}");
-        let (radiance, transmittance) = clouds_over_depth(convention, None, technique);
+        let (radiance, transmittance) = draw(&mut clouds, None);
         assert!(
             radiance > 0.0 && transmittance < max_clear_transmittance,
             "{technique:?} {convention:?}: an empty depth buffer shows the clouds: T = {transmittance}"
@@ -112,7 +124,13 @@ fn particles_respect_the_depth_buffer_through_the_upsampling() {
 #[test]
 fn statistics_come_back_without_waiting() {
     let ctx = GpuContext::for_tests();
-    let (mut clouds, frame) = begun(&ctx, DepthConvention::Standard, Technique::Raymarch);
+    let mut clouds = renderer(&ctx, Technique::Raymarch);
+    let frame = begin(
+        &ctx,
+        &mut clouds,
+        DepthConvention::Standard,
+        Technique::Raymarch,
+    );
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let depth = depth_buffer(&ctx, &mut encoder, frame.size, 1.0);
     clouds.encode_clouds(&ctx, &mut encoder, &depth, None, None);

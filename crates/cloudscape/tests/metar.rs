@@ -277,7 +277,10 @@ fn a_report_from_the_command_line_replaces_the_files_layers_and_visibility() {
 #[test]
 fn a_time_of_day_from_the_command_line_replaces_the_files_sun_angles() {
     let text = "[sun]\nelevation_deg = 40.0\n";
-    let overrides = ["sun.time_of_day={ solar_time_h = 9.0, latitude_deg = 48.0, day_of_year = 172 }".to_string()];
+    let overrides = [
+        "sun.time_of_day={ solar_time_h = 9.0, latitude_deg = 48.0, day_of_year = 172 }"
+            .to_string(),
+    ];
     let document = SceneDocument::parse(text, "scene.toml", Path::new("."), &overrides).unwrap();
     assert_ne!(document.scene.sun.elevation_deg, 40.0);
     assert_eq!(

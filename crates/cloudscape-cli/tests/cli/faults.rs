@@ -56,7 +56,11 @@ fn interrupt_after(dir: &Path, args: &[&str], cue: &'static str) -> (ExitStatus,
     let status = child.wait().expect("wait for cloudscape");
     let stderr = reader.join().expect("stderr reader");
     assert!(seen.is_ok(), "never printed {cue:?}:\n{stderr}");
-    assert!(killed, "SIGINT not sent: {}", std::io::Error::last_os_error());
+    assert!(
+        killed,
+        "SIGINT not sent: {}",
+        std::io::Error::last_os_error()
+    );
     (status, stderr)
 }
 

@@ -24,7 +24,10 @@ pub fn met(missing: Option<Missing>) -> bool {
     };
     let thread = std::thread::current();
     let test = thread.name().unwrap_or("a test");
-    let line = format!("not run: {test}: needs {} ({})", missing.what, missing.remedy);
+    let line = format!(
+        "not run: {test}: needs {} ({})",
+        missing.what, missing.remedy
+    );
     assert!(!on_ci(), "{line}; with CI=true every test runs");
     let _ = writeln!(std::io::stderr(), "{line}");
     false

@@ -14,9 +14,9 @@ pub mod test_gpu;
 pub mod timing;
 
 pub use context::{Backend, GpuContext, GpuError, GpuOptions};
-pub use test_gpu::{TEST_BACKEND_ENV, TestGpu};
 pub use memory::GpuMemoryReport;
 pub use readback::{read_buffer, read_texture, read_texture_rgba16f, read_texture_rgba32f};
+pub use test_gpu::{TEST_BACKEND_ENV, TestGpu};
 pub use timing::PassTimer;
 pub mod late_readback;
 #[cfg(test)]

@@ -43,7 +43,10 @@ pub(super) fn apply_all<'a>(
 /// and names them; else nothing.
 fn replace_derived(root: &mut DeTable<'_>, key: &str) -> Option<String> {
     let (source, derived) = DERIVED.iter().find(|(source, _)| {
-        key == *source || key.strip_prefix(source).is_some_and(|rest| rest.starts_with('.'))
+        key == *source
+            || key
+                .strip_prefix(source)
+                .is_some_and(|rest| rest.starts_with('.'))
     })?;
     let removed: Vec<&str> = derived
         .iter()
