@@ -7,12 +7,38 @@ use cloudscape::renderer::SceneRenderer;
 use cloudscape::scene::{Scene, Technique};
 use std::path::Path;
 
-/// `scene` rendered at 128 x 72 (HDR).
-fn render(ctx: &GpuContext, mut scene: Scene) -> HdrImage {
-    scene.render.width = 128;
-    scene.render.height = 72;
-    let mut renderer = SceneRenderer::new(ctx, &scene, Path::new(".")).expect("field builds");
-    renderer.render(ctx, &scene, |_| {}).hdr
+/// Renders scenes at 128 x 72 (HDR) with one renderer, which each new scene updates as a live
+/// edit in the viewer does.
+struct Renders<'a> {
+    ctx: &'a GpuContext,
+    renderer: Option<SceneRenderer>,
+}
+
+impl<'a> Renders<'a> {
+    fn new(ctx: &'a GpuContext) -> Renders<'a> {
+        Renders {
+            ctx,
+            renderer: None,
+        }
+    }
+
+    /// `scene` at 128 x 72.
+    fn render(&mut self, mut scene: Scene) -> HdrImage {
+        scene.render.width = 128;
+        scene.render.height = 72;
+        let (ctx, here) = (self.ctx, Path::new("."));
+        let renderer = match &mut self.renderer {
+            Some(renderer) => {
+                let clouds = renderer.clouds();
+                clouds
+                    .update_scene(ctx, &scene, here)
+                    .expect("field builds");
+                renderer
+            }
+            empty => empty.insert(SceneRenderer::new(ctx, &scene, here).expect("field builds")),
+        };
+        renderer.render(ctx, &scene, |_| {}).hdr
+    }
 }
 
 fn luminance(p: &[f32; 4]) -> f32 {
@@ -28,10 +54,11 @@ fn mean_luminance(image: &HdrImage) -> f32 {
 #[test]
 fn twilight_and_night_are_dark_and_finite() {
     let ctx = GpuContext::for_tests();
-    let at = |elevation_deg| {
+    let mut renders = Renders::new(&ctx);
+    let mut at = |elevation_deg| {
         let mut scene = Scene::default();
         scene.sun.elevation_deg = elevation_deg;
-        render(&ctx, scene)
+        renders.render(scene)
     };
     let (noon, twilight, night) = (at(30.0), at(-3.0), at(-25.0));
     for (name, image) in [("twilight", &twilight), ("night", &night)] {
@@ -69,7 +96,8 @@ fn cloud_shadows_fall_on_the_ground_for_every_technique() {
     scene.layers[0].coverage = 0.4;
     let mut clear = scene.clone();
     clear.layers.clear();
-    let clear_view = render(&ctx, clear);
+    let mut renders = Renders::new(&ctx);
+    let clear_view = renders.render(clear);
     for technique in [
         Technique::Raymarch,
         Technique::Particles,
@@ -77,7 +105,7 @@ fn cloud_shadows_fall_on_the_ground_for_every_technique() {
     ] {
         let mut cloudy = scene.clone();
         cloudy.render.technique = technique;
-        let image = render(&ctx, cloudy);
+        let image = renders.render(cloudy);
         let shadowed = image
             .pixels
             .iter()

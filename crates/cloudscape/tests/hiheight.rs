@@ -6,31 +6,38 @@ use cloudscape::renderer::SceneRenderer;
 use cloudscape::scene::SceneDocument;
 use std::path::Path;
 
-/// Renders the layer from `view` with skipping on or off; returns the image and the view-ray
-/// density samples per pixel.
-fn render(view: &[&str], skipping: bool) -> (HdrImage, f64) {
-    let mut overrides: Vec<String> = view.iter().map(|s| s.to_string()).collect();
-    overrides.extend(
-        [
-            "render.width=128",
-            "render.height=72",
-            "render.quality=medium",
-        ]
-        .map(String::from),
-    );
-    overrides.push(format!("render.empty_space_skipping={skipping}"));
-    let doc = SceneDocument::parse("", "hi-height test", Path::new("."), &overrides)
-        .expect("valid scene");
+/// Renders the layer from `view` with skipping on, then off (a live edit of the same renderer);
+/// returns each image with its view-ray density samples per pixel.
+fn render(view: &[&str]) -> [(HdrImage, f64); 2] {
     let ctx = GpuContext::for_tests();
-    let mut renderer = SceneRenderer::new(&ctx, &doc.scene, Path::new(".")).expect("field");
-    let image = renderer.render(&ctx, &doc.scene, |_| {}).hdr;
-    (
-        image,
+    let mut renderer = None;
+    [true, false].map(|skipping| {
+        let mut overrides: Vec<String> = view.iter().map(|s| s.to_string()).collect();
+        overrides.extend(
+            [
+                "render.width=128",
+                "render.height=72",
+                "render.quality=medium",
+            ]
+            .map(String::from),
+        );
+        overrides.push(format!("render.empty_space_skipping={skipping}"));
+        let doc = SceneDocument::parse("", "hi-height test", Path::new("."), &overrides)
+            .expect("valid scene");
+        let renderer: &mut SceneRenderer = match &mut renderer {
+            Some(renderer) => renderer,
+            empty => {
+                empty.insert(SceneRenderer::new(&ctx, &doc.scene, Path::new(".")).expect("field"))
+            }
+        };
         renderer
-            .stats(&ctx)
-            .expect("the frame was counted")
-            .density_samples_per_pixel,
-    )
+            .clouds()
+            .update_scene(&ctx, &doc.scene, Path::new("."))
+            .expect("field");
+        let image = renderer.render(&ctx, &doc.scene, |_| {}).hdr;
+        let stats = renderer.stats(&ctx).expect("the frame was counted");
+        (image, stats.density_samples_per_pixel)
+    })
 }
 
 fn largest_difference(a: &HdrImage, b: &HdrImage) -> f32 {
@@ -44,8 +51,7 @@ fn largest_difference(a: &HdrImage, b: &HdrImage) -> f32 {
 #[test]
 fn skipping_keeps_the_image_and_saves_samples_above_the_layer() {
     let above = ["camera.position_m=[0,6500,0]", "camera.pitch_deg=-35"];
-    let (with, samples_with) = render(&above, true);
-    let (without, samples_without) = render(&above, false);
+    let [(with, samples_with), (without, samples_without)] = render(&above);
     eprintln!(
         "above the layer: {samples_without:.1} -> {samples_with:.1} density samples per pixel"
     );
@@ -62,8 +68,7 @@ fn skipping_keeps_the_image_and_saves_samples_above_the_layer() {
 
 #[test]
 fn skipping_keeps_the_image_from_the_ground() {
-    let (with, samples_with) = render(&[], true);
-    let (without, samples_without) = render(&[], false);
+    let [(with, samples_with), (without, samples_without)] = render(&[]);
     eprintln!(
         "from the ground: {samples_without:.1} -> {samples_with:.1} density samples per pixel"
     );
@@ -80,7 +85,6 @@ fn skipping_keeps_the_image_on_grazing_rays_with_several_samples() {
         "render.samples_per_pixel=8",
         "render.primary_steps=64",
     ];
-    let (with, _) = render(&grazing, true);
-    let (without, _) = render(&grazing, false);
+    let [(with, _), (without, _)] = render(&grazing);
     assert_eq!(largest_difference(&with, &without), 0.0);
 }

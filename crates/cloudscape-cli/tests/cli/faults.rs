@@ -210,9 +210,9 @@ fn a_short_soak_keeps_its_memory_and_reports_it() {
     let args = [
         "bench",
         "--soak",
-        "70",
+        "35",
         "--soak-edit-every",
-        "10",
+        "5",
         "--warmup",
         "2",
         "--width",
@@ -227,6 +227,6 @@ fn a_short_soak_keeps_its_memory_and_reports_it() {
     for figure in ["resident memory", "live wgpu objects", "14 live edits"] {
         assert!(run.stdout.contains(figure), "{figure}:\n{}", run.stdout);
     }
-    // 70 frames are one cycle of the seven edits; its figures are progress, logged on stderr.
+    // 35 frames are one cycle of the seven edits; its figures are progress, logged on stderr.
     assert!(run.stderr.contains("cycle 1: resident"), "{}", run.stderr);
 }
