@@ -10,7 +10,7 @@ use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, PassTimer};
 use cloudscape::image::LdrImage;
 use cloudscape::renderer::{PASS_COUNT, Rendered, Reuse, SceneRenderer};
-use cloudscape::scene::{CloudLayer, Scene, SceneDocument};
+use cloudscape::scene::{Scene, SceneDocument};
 use ffmpeg::Mp4Writer;
 use glam::UVec2;
 use std::path::{Path, PathBuf};
@@ -181,17 +181,17 @@ impl Previews {
     }
 }
 
-/// A renderer for the frames of one scene, rebuilt only when a still's layers (whose coverage the
-/// animation may change) differ from those its cloud field was built from. A rebuild restarts the
-/// temporal history.
+/// A renderer for the frames of one scene, built once: a still whose layers (whose coverage the
+/// animation may change) differ from the last one's is a live edit of its cloud field, which
+/// restarts the temporal history.
 struct FrameRenderer<'a> {
     ctx: &'a GpuContext,
     doc: &'a SceneDocument,
-    /// The renderer and the layers its cloud field was built from.
-    renderer: Option<(SceneRenderer, Vec<CloudLayer>)>,
+    renderer: Option<SceneRenderer>,
     /// Temporal reuse and the timer its frames need; None renders every frame as a still.
     temporal: Option<(Reuse, PassTimer)>,
-    rebuilds: u32,
+    /// Frames whose cloud field was updated from the one before.
+    field_updates: u32,
 }
 
 impl<'a> FrameRenderer<'a> {
@@ -201,32 +201,34 @@ impl<'a> FrameRenderer<'a> {
             doc,
             renderer: None,
             temporal: temporal.map(|d| (temporal_reuse(d), PassTimer::new(ctx, PASS_COUNT))),
-            rebuilds: 0,
+            field_updates: 0,
         }
     }
 
     /// Renders `still` as frame `index` of the sequence.
     fn render(&mut self, still: &Scene, index: u32, progress: impl FnMut(f32)) -> Result<Rendered> {
-        let stale = self
-            .renderer
-            .as_ref()
-            .is_none_or(|(_, layers)| *layers != still.layers);
-        if stale {
-            let renderer = SceneRenderer::new(self.ctx, still, &self.doc.resolve_path(""))
-                .map_err(|e| anyhow!(self.doc.error_at(&e.key_path, e.message)))?;
-            self.rebuilds += u32::from(self.renderer.is_some());
-            self.renderer = Some((renderer, still.layers.clone()));
-        }
-        let (renderer, _) = self.renderer.as_mut().expect("built above");
+        let located =
+            |e: cloudscape::field::FieldError| anyhow!(self.doc.error_at(&e.key_path, e.message));
+        let base_dir = self.doc.resolve_path("");
+        let renderer = match &mut self.renderer {
+            Some(renderer) => {
+                let update = renderer
+                    .set_scene(self.ctx, still, &base_dir)
+                    .map_err(located)?;
+                self.field_updates += u32::from(update.is_some());
+                renderer
+            }
+            empty => empty.insert(SceneRenderer::new(self.ctx, still, &base_dir).map_err(located)?),
+        };
         let Some((reuse, timer)) = self.temporal.as_mut() else {
-            return Ok(renderer.render(self.ctx, still, progress));
+            return Ok(renderer.render(self.ctx, progress));
         };
         let size = UVec2::new(still.render.width, still.render.height);
         let frame = Frame {
             frame_index: index,
             ..Frame::from_scene(still, size)
         };
-        renderer.render_frame(self.ctx, still, &frame, *reuse, timer);
+        renderer.render_frame(self.ctx, &frame, *reuse, timer);
         Ok(renderer.images(self.ctx))
     }
 }
@@ -277,10 +279,10 @@ pub fn run(args: AnimateArgs) -> Result<()> {
     stages.run("rendering frames", || {
         render_frames(&mut frames, &sequence, &args.out, &mut previews)
     })?;
-    if frames.rebuilds > 0 {
+    if frames.field_updates > 0 {
         eprintln!(
-            "coverage changed: the cloud field was rebuilt for {} of {} frames",
-            frames.rebuilds, sequence.frames
+            "coverage changed: the cloud field was updated for {} of {} frames",
+            frames.field_updates, sequence.frames
         );
     }
     let written = stages.run("finishing previews", || previews.finish(&args.out))?;

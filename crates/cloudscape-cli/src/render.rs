@@ -40,7 +40,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     );
     let bar = progress_bar("rendering");
     let images = stages.run("rendering", || {
-        Ok(renderer.render(&ctx, scene, |f| bar.set_position((f * 1000.0) as u64)))
+        Ok(renderer.render(&ctx, |f| bar.set_position((f * 1000.0) as u64)))
     })?;
     bar.finish_and_clear();
     let out = PathBuf::from(&scene.render.output);

@@ -41,11 +41,12 @@ pub struct GroundPoint {
 }
 
 impl Environment {
-    /// The environment the GPU techniques light with (`light`), with the ground of `frame`, over
-    /// `planet`.
+    /// The environment the GPU techniques light with (`light`), seen from `frame`'s camera, with a
+    /// ground of albedo `ground_albedo` (None: no ground) over `planet`.
     pub fn new(
         frame: &Frame,
         light: &cloudscape::environment::Environment,
+        ground_albedo: Option<Vec3>,
         planet: PlanetGeometry,
     ) -> Environment {
         let sun = (light.sun.irradiance.max_element() > 0.0).then_some(light.sun);
@@ -55,7 +56,7 @@ impl Environment {
             sun,
             sky: light.sky,
             planet,
-            ground_albedo: frame.ground_albedo,
+            ground_albedo,
             atmosphere,
         }
     }

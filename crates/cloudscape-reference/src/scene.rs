@@ -10,7 +10,7 @@ use crate::medium::Medium;
 use crate::particle_set_medium::ParticleSetMedium;
 use crate::tracking::TrackedMedium;
 use cloudscape::field::{CloudField, FieldError, PlanetGeometry};
-use cloudscape::frame::Frame;
+use cloudscape::frame::{Frame, FrameSettings};
 use cloudscape::optics::PhaseLobes;
 use cloudscape::particles::density::ReferenceParticle;
 use cloudscape::particles::generate::Particle;
@@ -115,7 +115,8 @@ impl<M: Medium> PathTracer<M> {
     ) -> PathTracer<M> {
         let frame = Frame::from_scene(scene, size);
         let light = cloudscape::environment::Environment::from_scene(scene);
-        let environment = Environment::new(&frame, &light, planet);
+        let ground_albedo = FrameSettings::from_scene(scene).ground_albedo;
+        let environment = Environment::new(&frame, &light, ground_albedo, planet);
         let medium = medium(&frame);
         PathTracer {
             volume: TrackedMedium::new(medium, majorant_cells),

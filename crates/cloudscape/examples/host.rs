@@ -5,7 +5,7 @@
 //!
 //! `cargo run -p cloudscape --example host -- [OUT.png]`
 
-use cloudscape::frame::{DepthConvention, Frame};
+use cloudscape::frame::{DepthConvention, Frame, FrameSun, direction_from_angles_deg};
 use cloudscape::gpu::{GpuContext, read_texture, read_texture_rgba16f};
 use cloudscape::image::LdrImage;
 use cloudscape::post::Background;
@@ -39,18 +39,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (device, queue) = pollster::block_on(adapter.request_device(&Default::default()))?;
     let gpu = GpuContext::from_wgpu(adapter, device, queue);
 
-    // The host's camera, with a reversed-Z infinite projection (Bevy's convention).
+    // The clouds' settings: the sky and its layers, read once.
     let doc = SceneDocument::parse(
         "",
         "host scene",
         ".".as_ref(),
         &["layers.0.coverage=0.75".into()],
     )?;
-    let scene = &doc.scene;
-    let eye = Vec3::from_array(scene.camera.position_m);
+    let mut clouds = CloudRenderer::new(&gpu, &doc.scene, ".".as_ref())?;
+
+    // Each frame, the host's own camera (reversed-Z infinite projection, Bevy's convention), sun
+    // and clock.
+    let eye = Vec3::new(0.0, 30.0, 0.0);
     let forward = Vec3::new(-0.34, 0.25, 0.94).normalize();
     let depth = DepthConvention::ReversedInfinite;
     let frame = Frame {
+        size: SIZE,
         camera_position_m: eye,
         view_from_world: glam::camera::rh::view::look_to_mat4(eye, forward, Vec3::Y),
         clip_from_view: depth.perspective(
@@ -60,23 +64,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             1.0e5,
         ),
         depth,
-        ..Frame::from_scene(scene, SIZE)
+        far_m: 1.2e5,
+        sun: FrameSun {
+            direction: direction_from_angles_deg(30.0, 215.0),
+            irradiance: Vec3::splat(8.0),
+            angular_radius_rad: 0.2679f32.to_radians(),
+        },
+        time_s: 0.0,
+        exposure_ev: 0.0,
+        frame_index: 0,
     };
 
     // The host draws its geometry into its own colour and depth targets.
     let targets = HostTargets::new(&gpu);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    draw_geometry(&gpu, &mut encoder, &targets, &frame, scene);
+    draw_geometry(&gpu, &mut encoder, &targets, &frame);
 
     // Clouds over it: the library reads the host's depth and colour and composes.
-    let mut clouds = CloudRenderer::new(&gpu, scene, ".".as_ref())?;
-    clouds.begin_frame(&gpu, scene, &frame, Reuse::None);
+    clouds.begin_frame(&gpu, &frame, Reuse::None);
     clouds.encode_clouds(&gpu, &mut encoder, &targets.depth, None, None);
     let background = Background {
         color: &targets.color,
         depth: &targets.depth,
     };
-    clouds.encode_finish(&gpu, &mut encoder, scene, &background, None);
+    clouds.encode_finish(&gpu, &mut encoder, &background, None);
     gpu.queue.submit([encoder.finish()]);
 
     let images = clouds.images();
@@ -177,10 +188,9 @@ fn draw_geometry(
     encoder: &mut wgpu::CommandEncoder,
     targets: &HostTargets,
     frame: &Frame,
-    scene: &cloudscape::scene::Scene,
 ) {
     let device = &gpu.device;
-    let sun = cloudscape::environment::Environment::from_scene(scene).sun;
+    let sun = frame.sun;
     let mut view = frame.clip_from_world().to_cols_array().to_vec();
     view.extend(
         sun.direction

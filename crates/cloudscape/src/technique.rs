@@ -5,12 +5,14 @@
 //! [`crate::output::SampleGrid`]. It never draws the sky, applies haze, tone-maps or keeps history:
 //! temporal reuse, upsampling and compositing serve every technique from its output.
 
-use crate::field::CloudField;
+use crate::environment::Environment;
+use crate::field::{CloudField, FieldError};
 use crate::frame::{Frame, Shared};
 use crate::gpu::{GpuContext, PassTimer};
 use crate::output::{CloudOutput, SampleGrid};
 use crate::scene::Scene;
 use glam::UVec2;
+use std::path::Path;
 
 /// What a technique counted in a frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,17 +26,18 @@ pub struct TechniqueStats {
     pub primitives: Option<u32>,
 }
 
-/// What a frame is made of, on the CPU: the scene's settings, the field they describe, the view
-/// and the sample grid of the output. Techniques that work on the CPU (sorting, generating
-/// sprites) read the camera here, as the host set it.
+/// What a frame is made of, on the CPU: the field, the host's view, sun and clock, the environment
+/// they make and the sample grid of the output. Techniques that work on the CPU (generating
+/// particles, sprites) read the camera here, as the host set it. The scene is not here: a
+/// technique reads it in [`Technique::configure`], not per frame.
 #[derive(Clone, Copy)]
 pub struct FrameInputs<'a> {
-    /// This frame's scene (steps, lighting, sun, time).
-    pub scene: &'a Scene,
     /// The cloud field (the CPU specification).
     pub field: &'a CloudField,
-    /// The host's camera, projection, depth convention and time.
+    /// The host's camera, projection, depth convention, sun and time.
     pub frame: &'a Frame,
+    /// The frame's sun, sky and haze.
+    pub environment: &'a Environment,
     /// The rays the output holds.
     pub grid: &'a SampleGrid,
 }
@@ -59,11 +62,22 @@ pub trait Technique {
 
     /// The resolution divisor (1, 2 or 4) of its output in frames without temporal reuse; the
     /// shared upsampling brings it to full resolution.
-    fn still_divisor(&self, _scene: &Scene) -> u32 {
+    fn still_divisor(&self) -> u32 {
         1
     }
 
-    /// Takes this frame's settings (steps, lighting, phase function) and view.
+    /// Takes the scene's settings (steps, lighting, phase function, its own section) and reads
+    /// the files they name that only it draws (a sprite model; relative paths resolve against
+    /// `base_dir`; an unreadable one is an error at its scene key). Called when the technique is
+    /// built and after every edit of the scene, never per frame.
+    fn configure(
+        &mut self,
+        ctx: &GpuContext,
+        scene: &Scene,
+        base_dir: &Path,
+    ) -> Result<(), FieldError>;
+
+    /// Takes this frame's view, sun and clock.
     fn prepare(&mut self, ctx: &GpuContext, inputs: &FrameInputs);
 
     /// Records the technique over the output texels `region` (origin, size): the whole output, or

@@ -29,15 +29,12 @@ impl<'a> Renders<'a> {
         let (ctx, here) = (self.ctx, Path::new("."));
         let renderer = match &mut self.renderer {
             Some(renderer) => {
-                let clouds = renderer.clouds();
-                clouds
-                    .update_scene(ctx, &scene, here)
-                    .expect("field builds");
+                renderer.set_scene(ctx, &scene, here).expect("field builds");
                 renderer
             }
             empty => empty.insert(SceneRenderer::new(ctx, &scene, here).expect("field builds")),
         };
-        renderer.render(ctx, &scene, |_| {}).hdr
+        renderer.render(ctx, |_| {}).hdr
     }
 }
 

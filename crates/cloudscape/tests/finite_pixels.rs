@@ -46,10 +46,9 @@ fn fixed(case: &[&str; 4]) -> Vec<String> {
 /// Renders `scene` with `renderer` (a live edit rebuilds what changed); its HDR pixels.
 fn render(ctx: &GpuContext, renderer: &mut SceneRenderer, scene: &Scene) -> Vec<[f32; 4]> {
     renderer
-        .clouds()
-        .update_scene(ctx, scene, Path::new("."))
+        .set_scene(ctx, scene, Path::new("."))
         .expect("the field builds");
-    renderer.render(ctx, scene, |_| {}).hdr.pixels
+    renderer.render(ctx, |_| {}).hdr.pixels
 }
 
 #[test]

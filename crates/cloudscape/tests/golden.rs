@@ -27,7 +27,7 @@ fn render(toml: &str, base_dir: &Path, overrides: &[&str]) -> LdrImage {
         .expect("golden scenes are valid");
     let ctx = GpuContext::for_tests();
     let mut renderer = SceneRenderer::new(&ctx, &doc.scene, base_dir).expect("field builds");
-    renderer.render(&ctx, &doc.scene, |_| {}).ldr
+    renderer.render(&ctx, |_| {}).ldr
 }
 
 #[test]

@@ -35,7 +35,7 @@ fn compare(scene: &Scene, base_dir: &std::path::Path, points: &[Vec3], time_s: f
         time_s,
         ..Frame::from_scene(scene, UVec2::new(16, 16))
     };
-    clouds.begin_frame(&ctx, scene, &frame, Reuse::None);
+    clouds.begin_frame(&ctx, &frame, Reuse::None);
     let inputs: Vec<ProbeInput> = points
         .iter()
         .map(|p| ProbeInput {

@@ -31,10 +31,9 @@ fn render(view: &[&str]) -> [(HdrImage, f64); 2] {
             }
         };
         renderer
-            .clouds()
-            .update_scene(&ctx, &doc.scene, Path::new("."))
+            .set_scene(&ctx, &doc.scene, Path::new("."))
             .expect("field");
-        let image = renderer.render(&ctx, &doc.scene, |_| {}).hdr;
+        let image = renderer.render(&ctx, |_| {}).hdr;
         let stats = renderer.stats(&ctx).expect("the frame was counted");
         (image, stats.density_samples_per_pixel)
     })

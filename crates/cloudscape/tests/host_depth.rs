@@ -33,7 +33,7 @@ fn begin(
 ) -> Frame {
     let scene = overcast(technique);
     let frame = Frame::from_scene(&scene, UVec2::new(64, 36)).with_depth(&scene, convention);
-    clouds.begin_frame(ctx, &scene, &frame, Reuse::None);
+    clouds.begin_frame(ctx, &frame, Reuse::None);
     frame
 }
 
@@ -80,7 +80,7 @@ fn clouds_over_depth(
         color: &color,
         depth: &depth_view,
     };
-    clouds.encode_finish(ctx, &mut encoder, &overcast(technique), &background, None);
+    clouds.encode_finish(ctx, &mut encoder, &background, None);
     ctx.queue.submit([encoder.finish()]);
     let pixels = read_texture_rgba16f(ctx, clouds.images().clouds.radiance_texture());
     let radiance: f32 = pixels.iter().map(|p| p[0] + p[1] + p[2]).sum();
@@ -134,13 +134,12 @@ fn statistics_come_back_without_waiting() {
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let depth = depth_buffer(&ctx, &mut encoder, frame.size, 1.0);
     clouds.encode_clouds(&ctx, &mut encoder, &depth, None, None);
-    let scene = Scene::default();
     let color = host_colour(&ctx, frame.size);
     let background = cloudscape::post::Background {
         color: &color,
         depth: &depth,
     };
-    clouds.encode_finish(&ctx, &mut encoder, &scene, &background, None);
+    clouds.encode_finish(&ctx, &mut encoder, &background, None);
     ctx.queue.submit([encoder.finish()]);
     // Asking does not wait: the answer is this frame's counters or none yet.
     let early = clouds.stats(&ctx);

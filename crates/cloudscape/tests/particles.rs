@@ -48,11 +48,14 @@ impl Harness {
     /// Renders one full-resolution frame of `scene` seen through `frame`; the radiance and
     /// transmittance per texel.
     fn render(&mut self, ctx: &GpuContext, scene: &Scene, frame: &Frame) -> Vec<[f32; 4]> {
-        self.clouds.begin_frame(ctx, scene, frame, Reuse::None);
+        self.clouds.begin_frame(ctx, frame, Reuse::None);
+        self.particles
+            .configure(ctx, scene, Path::new("."))
+            .expect("the particles' tables load");
         let inputs = FrameInputs {
-            scene,
             field: self.clouds.field(),
             frame,
+            environment: self.clouds.environment(),
             grid: &SampleGrid::FULL,
         };
         self.particles.prepare(ctx, &inputs);

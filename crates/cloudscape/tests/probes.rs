@@ -4,7 +4,7 @@
 //! GPU without regenerating the noise.
 
 use cloudscape::environment::{Environment, ViewedEnvironment};
-use cloudscape::frame::{DepthConvention, Frame};
+use cloudscape::frame::{DepthConvention, Frame, FrameSettings};
 use cloudscape::gpu::GpuContext;
 use cloudscape::optics::{
     Octaves, PhaseLobes, SunSlab, diffuse_transmittance, two_stream_share_from_below,
@@ -23,7 +23,7 @@ const SIZE: UVec2 = UVec2::new(64, 36);
 /// filled.
 fn renderer(ctx: &GpuContext, scene: &Scene, frame: &Frame) -> CloudRenderer {
     let mut clouds = CloudRenderer::new(ctx, scene, Path::new(".")).expect("field");
-    clouds.begin_frame(ctx, scene, frame, Reuse::None);
+    clouds.begin_frame(ctx, frame, Reuse::None);
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     clouds.encode_environment(ctx, &mut encoder, None);
     ctx.queue.submit([encoder.finish()]);
@@ -277,7 +277,12 @@ fn analytic_environment_functions_match_the_cpu() {
     let got = gpu(&ctx, &clouds, ProbeFunction::DiffuseTransmittance, &taus);
     let want: Vec<Vec4> = taus
         .iter()
-        .map(|t| Vec4::splat(diffuse_transmittance(t.a.x, frame.cloud_mean_cosine)))
+        .map(|t| {
+            Vec4::splat(diffuse_transmittance(
+                t.a.x,
+                FrameSettings::from_scene(&scene).cloud_mean_cosine,
+            ))
+        })
         .collect();
     assert_close("diffuse transmittance", &got, &want, 1e-5);
     let pairs: Vec<ProbeInput> = (0..50)
@@ -295,7 +300,7 @@ fn analytic_environment_functions_match_the_cpu() {
     let want: Vec<Vec4> = pairs
         .iter()
         .map(|t| {
-            let g = frame.cloud_mean_cosine;
+            let g = FrameSettings::from_scene(&scene).cloud_mean_cosine;
             Vec4::splat(two_stream_share_from_below(t.a.x, t.a.y, g))
         })
         .collect();
@@ -637,7 +642,6 @@ fn a_live_edit_reaches_the_gpu_without_new_noise() {
     );
     clouds.begin_frame(
         &ctx,
-        &scene,
         &Frame {
             time_s: 20.0,
             ..frame

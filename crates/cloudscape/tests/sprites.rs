@@ -22,7 +22,7 @@ fn scene(toml: &str, overrides: &[&str], size: UVec2) -> Scene {
 /// A still of `scene`.
 fn still(ctx: &GpuContext, scene: &Scene) -> LdrImage {
     let mut renderer = SceneRenderer::new(ctx, scene, Path::new(".")).expect("builds");
-    renderer.render(ctx, scene, |_| {}).ldr
+    renderer.render(ctx, |_| {}).ldr
 }
 
 #[test]
@@ -79,7 +79,7 @@ fn fly_through(ctx: &GpuContext, frames: u32) -> Vec<HdrImage> {
                 frame_index: i,
                 ..Frame::from_scene(&s, size)
             };
-            renderer.render_frame(ctx, &s, &frame, Reuse::None, &mut timer);
+            renderer.render_frame(ctx, &frame, Reuse::None, &mut timer);
             renderer.images(ctx).hdr
         })
         .collect()

@@ -61,7 +61,7 @@ fn steady_frames(ctx: &GpuContext, technique: Technique) {
             frame_index: index,
             ..Frame::from_scene(&doc.scene, SIZE)
         };
-        renderer.render_frame(ctx, &doc.scene, &frame, reuse, &mut timer);
+        renderer.render_frame(ctx, &frame, reuse, &mut timer);
     };
     (0..WARMUP_FRAMES).for_each(&mut render);
     let before = resident_bytes();

@@ -32,7 +32,7 @@ fn converged(ctx: &GpuContext, scene: &Scene, frame: &Frame) -> LdrImage {
     still.render.primary_steps = Some(128);
     let mut renderer = SceneRenderer::new(ctx, &still, Path::new(".")).expect("field");
     let mut timer = PassTimer::new(ctx, PASS_COUNT);
-    renderer.render_frame(ctx, &still, frame, Reuse::None, &mut timer);
+    renderer.render_frame(ctx, frame, Reuse::None, &mut timer);
     renderer.images(ctx).ldr
 }
 
@@ -63,7 +63,7 @@ impl Sequence {
         frame.frame_index = self.index;
         self.index += 1;
         self.renderer
-            .render_frame(ctx, &s, &frame, self.reuse, &mut self.timer);
+            .render_frame(ctx, &frame, self.reuse, &mut self.timer);
         self.renderer.images(ctx).ldr
     }
 }

@@ -168,7 +168,7 @@ fn time_frames(args: &BenchArgs, ctx: &GpuContext, extra: &[String]) -> Result<R
     let mut wall_ms = Vec::new();
     for i in 0..args.warmup + frames {
         frame.frame_index = i;
-        let wall = renderer.render_frame(ctx, scene, &frame, reuse, &mut timer);
+        let wall = renderer.render_frame(ctx, &frame, reuse, &mut timer);
         if i < args.warmup {
             continue;
         }

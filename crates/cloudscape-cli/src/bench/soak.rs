@@ -191,8 +191,7 @@ impl<'a> Soak<'a> {
         self.doc = self.args.scene.load(&overrides)?;
         let scene = &self.doc.scene;
         self.renderer
-            .clouds()
-            .update_scene(ctx, scene, &self.doc.resolve_path(""))
+            .set_scene(ctx, scene, &self.doc.resolve_path(""))
             .map_err(|e| anyhow!(self.doc.error_at(&e.key_path, e.message)))?;
         self.edits += 1;
         Ok(())
@@ -219,7 +218,7 @@ impl<'a> Soak<'a> {
         for _ in 0..count {
             let frame = self.moving_frame();
             self.renderer
-                .render_frame(ctx, &self.doc.scene, &frame, reuse, &mut self.timer);
+                .render_frame(ctx, &frame, reuse, &mut self.timer);
             self.frame_index += 1;
             if let Some(bar) = bar {
                 bar.inc(1);

@@ -132,10 +132,10 @@ pub fn measure(
         .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
     let frame = Frame::from_scene(&scene, UVec2::new(scene.render.width, scene.render.height));
     let mut timer = PassTimer::new(ctx, PASS_COUNT);
-    renderer.render_frame(ctx, &scene, &frame, Reuse::None, &mut timer);
+    renderer.render_frame(ctx, &frame, Reuse::None, &mut timer);
     let first_frame_ms = start.elapsed().as_secs_f64() * 1e3;
     let frame_ms = renderer
-        .render_frame(ctx, &scene, &frame, Reuse::None, &mut timer)
+        .render_frame(ctx, &frame, Reuse::None, &mut timer)
         .as_secs_f64()
         * 1e3;
     let rendered = renderer.images(ctx);

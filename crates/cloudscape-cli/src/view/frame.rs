@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Result;
-use cloudscape::frame::Frame;
+use cloudscape::frame::{Frame, FrameSun};
 use cloudscape::image::LdrImage;
 use cloudscape::renderer::{EmptyHost, Reuse};
 use cloudscape::scene::Scene;
@@ -52,7 +52,7 @@ impl Viewer {
         let vsync = self.view.vsync;
         let mut ui = self.run_panels();
         if let Some(key) = ui.output.edited.take() {
-            let draft = std::mem::take(&mut ui.draft);
+            let draft = unviewed(std::mem::take(&mut ui.draft), &self.live.scene);
             // A refused edit is shown in the panel; the scene stays as it was.
             let _ = self.change_scene(|live| live.edit(draft, &key));
         }
@@ -62,7 +62,7 @@ impl Viewer {
         let Some(surface) = self.presenter.acquire(&self.ctx) else {
             return Ok(());
         };
-        self.place_viewer_owned(render_size(ui.viewport.1, self.view.render_scale));
+        self.render_size = render_size(ui.viewport.1, self.view.render_scale);
         self.draw(&surface, &ui);
         if let Some(path) = self.window_shot_path() {
             self.capture_window(&ui, &path)?;
@@ -132,8 +132,8 @@ impl Viewer {
         let context = self.egui.egui_ctx().clone();
         let mut output = PanelOutput::default();
         let mut viewport = egui::Rect::NOTHING;
-        let mut draft = self.live.scene.clone();
-        let render_size = [self.live.scene.render.width, self.live.scene.render.height];
+        let mut draft = self.viewed_scene();
+        let render_size = self.render_size.to_array();
         let full = context.run_ui(input, |ui| {
             if self.view.panels {
                 let inputs = PanelInputs {
@@ -171,20 +171,35 @@ impl Viewer {
         }
     }
 
-    /// Writes what the viewer owns into the live scene: the camera it flies, the size it renders
-    /// at and its clock.
-    fn place_viewer_owned(&mut self, size: UVec2) {
-        let scene = &mut self.live.scene;
+    /// The live scene as it is viewed: with what the viewer owns (the camera it flies, the size it
+    /// renders at, its clock) in place of the file's, as the panels show it and a saved scene
+    /// holds it.
+    pub(super) fn viewed_scene(&self) -> Scene {
+        let mut scene = self.live.scene.clone();
         self.rig.pose.write_to(&mut scene.camera);
-        scene.render.width = size.x;
-        scene.render.height = size.y;
+        scene.render.width = self.render_size.x;
+        scene.render.height = self.render_size.y;
         scene.render.time_s = self.clock_s;
+        scene
+    }
+
+    /// This frame's view: the viewer's own camera (through the scene's lens), size and clock,
+    /// with the scene's sun and exposure.
+    fn view_frame(&self, frame_index: u32) -> Frame {
+        let scene = &self.live.scene;
+        let mut camera = scene.camera.clone();
+        self.rig.pose.write_to(&mut camera);
+        let sun = FrameSun::from_scene(&scene.sun);
+        Frame {
+            time_s: self.clock_s,
+            exposure_ev: scene.render.exposure_ev,
+            frame_index,
+            ..Frame::of_camera(&camera, self.render_size, sun)
+        }
     }
 
     /// Records and submits the clouds, then the image and the panels into `surface`.
     fn draw(&mut self, surface: &wgpu::SurfaceTexture, ui: &Ui) {
-        let scene = &self.live.scene;
-        let size = UVec2::new(scene.render.width, scene.render.height);
         // Without temporal reuse a frame is a still, as `cloudscape render` draws it; with it, the
         // index advances the jitter every frame, and the shadow map is kept while it serves.
         let (frame_index, shadow_reuse) = match self.view.temporal {
@@ -192,16 +207,13 @@ impl Viewer {
             None => (0, None),
         };
         self.clouds.set_shadow_reuse(shadow_reuse);
-        let frame = Frame {
-            frame_index,
-            ..Frame::from_scene(scene, size)
-        };
+        let frame = self.view_frame(frame_index);
         if self.host.as_ref().is_none_or(|h| !h.fits(&frame)) {
             self.host = Some(EmptyHost::new(&self.ctx, &frame));
         }
         let host = self.host.as_ref().expect("made above");
         let reuse = self.view.temporal.map_or(Reuse::None, Reuse::Temporal);
-        self.clouds.begin_frame(&self.ctx, scene, &frame, reuse);
+        self.clouds.begin_frame(&self.ctx, &frame, reuse);
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         self.timer.reset();
         let timer = Some(&mut self.timer);
@@ -209,7 +221,7 @@ impl Viewer {
             .encode_clouds(&self.ctx, &mut encoder, host.depth(), None, timer);
         let timer = Some(&mut self.timer);
         self.clouds
-            .encode_finish(&self.ctx, &mut encoder, scene, &host.background(), timer);
+            .encode_finish(&self.ctx, &mut encoder, &host.background(), timer);
         self.timer.resolve_late(&mut encoder);
         let target = surface.texture.create_view(&Default::default());
         let mut textures = std::mem::take(&mut self.pending_textures);
@@ -320,6 +332,19 @@ fn physical_rect(
         min,
         [max[0].saturating_sub(min[0]), max[1].saturating_sub(min[1])],
     )
+}
+
+/// `draft` (the viewed scene, as the panels edited it) with the live scene's own camera pose,
+/// render size and time back in place of the viewer's: those stay the viewer's, out of the scene.
+fn unviewed(mut draft: Scene, live: &Scene) -> Scene {
+    let (camera, own) = (&mut draft.camera, &live.camera);
+    camera.position_m = own.position_m;
+    camera.look_at_m = own.look_at_m;
+    camera.yaw_deg = own.yaw_deg;
+    camera.pitch_deg = own.pitch_deg;
+    let (render, own) = (&mut draft.render, &live.render);
+    (render.width, render.height, render.time_s) = (own.width, own.height, own.time_s);
+    draft
 }
 
 #[cfg(test)]

@@ -155,14 +155,13 @@ impl LiveScene {
             }
         }
     }
+}
 
-    /// Writes the live scene to `path` as a scene file that `cloudscape render` renders exactly
-    /// as viewed.
-    pub fn save(&self, path: &Path) -> Result<()> {
-        self.scene
-            .write_toml(path)
-            .with_context(|| format!("cannot write the scene to {}", path.display()))
-    }
+/// Writes `scene` to `path` as a scene file that `cloudscape render` renders exactly as viewed.
+pub fn save_scene(scene: &Scene, path: &Path) -> Result<()> {
+    scene
+        .write_toml(path)
+        .with_context(|| format!("cannot write the scene to {}", path.display()))
 }
 
 /// The file's modification time, if it can be read.
@@ -247,7 +246,7 @@ mod tests {
         live.set("sun.elevation_deg=12").unwrap();
         live.scene.camera.yaw_deg = 123.456;
         let path = scratch.0.join("saved.toml");
-        live.save(&path).unwrap();
+        save_scene(&live.scene, &path).unwrap();
         let saved = SceneDocument::load(Some(&path), &[]).unwrap().scene;
         assert_eq!(saved, live.scene);
         assert_eq!(saved.sun.elevation_deg, 12.0);

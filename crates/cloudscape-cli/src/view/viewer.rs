@@ -20,7 +20,7 @@ use winit::window::Window;
 use super::app::Setup;
 use super::camera::{CameraRig, Mode, distance_to_altitude_m};
 use super::keys::HeldKeys;
-use super::live::LiveScene;
+use super::live::{LiveScene, save_scene};
 use super::panel::{Panel, Request, ViewSettings};
 use super::present::Presenter;
 use super::script::{Script, held_motion};
@@ -87,6 +87,8 @@ pub struct Viewer {
     pub(super) frame_index: u64,
     /// Scene time, s.
     pub(super) clock_s: f32,
+    /// The size the clouds render at this frame (the viewport's, at the render scale), pixels.
+    pub(super) render_size: glam::UVec2,
     pub(super) last_frame: Instant,
     pub(super) frames: Option<u64>,
     pub(super) screenshot: Option<std::path::PathBuf>,
@@ -138,6 +140,7 @@ impl Viewer {
             },
             panel: Panel::new(live.default_save_path()),
             clock_s: live.scene.render.time_s,
+            render_size: glam::UVec2::new(width, height),
             keys: HeldKeys::default(),
             script_keys: None,
             mouse_look: false,
@@ -252,9 +255,7 @@ impl Viewer {
     /// Carries out a request of the panels or the keys.
     pub(super) fn handle(&mut self, request: Request) {
         let outcome = match request {
-            Request::Save(path) => self
-                .live
-                .save(&path)
+            Request::Save(path) => save_scene(&self.viewed_scene(), &path)
                 .map(|()| format!("saved {}", path.display())),
             Request::Screenshot(path) => self.write_screenshot(&path),
             Request::ResetCamera => {
@@ -332,7 +333,7 @@ impl Viewer {
                 self.write_screenshot(path)?;
             }
             if let Some(path) = &step.save {
-                self.live.save(path)?;
+                save_scene(&self.viewed_scene(), path)?;
                 eprintln!("saved {}", path.display());
             }
         }
@@ -350,7 +351,7 @@ impl Viewer {
         let base_dir = self.live.base_dir();
         let applied = self
             .clouds
-            .apply_edit(&self.ctx, &previous, &self.live.scene, &base_dir);
+            .apply_edit(&self.ctx, &self.live.scene, &base_dir);
         match applied {
             Ok(update) => {
                 if let Some(update) = update {

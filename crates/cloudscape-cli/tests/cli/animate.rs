@@ -71,7 +71,7 @@ fn animate_writes_exr_and_rebuilds_the_field_when_clouds_grow() {
     let run = animate(scratch.path(), &args);
     let messages = run.stderr;
     assert!(run.success, "{messages}");
-    assert!(messages.contains("rebuilt for 1 of 2 frames"), "{messages}");
+    assert!(messages.contains("updated for 1 of 2 frames"), "{messages}");
     let read = |i: u32| HdrImage::read(&scratch.join(&format!("anim/frame_{i:04}.exr")));
     let (sparse, dense) = (read(0).expect("frame 0"), read(1).expect("frame 1"));
     // Clouds are grey-white, the sky behind them blue: more cloud, more red for the blue.

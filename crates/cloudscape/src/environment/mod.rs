@@ -33,7 +33,7 @@ pub use passes::EnvironmentPasses;
 pub use table_pass::TablePass;
 
 use crate::atmosphere::{Air, Atmosphere, SkyView};
-use crate::frame::direction_from_angles_deg;
+use crate::frame::FrameSun;
 use crate::scene::Scene;
 pub use crate::scene::SkyModel;
 use glam::Vec3;
@@ -141,8 +141,30 @@ impl SunDisc {
     }
 }
 
-/// Sun, sky and haze as a scene describes them, before any viewpoint: the uniform of
-/// `environment.wgsl`.
+/// The sky and the air as a scene describes them: a renderer's settings, read when it is built or
+/// edited. With a frame's sun they make the frame's [`Environment`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sky {
+    /// The analytic sky and its haze (used by the gradient and constant models).
+    pub radiance: SkyRadiance,
+    /// Which sky lights the scene.
+    pub model: SkyModel,
+    /// The air of the atmosphere model.
+    pub air: Air,
+}
+
+impl Sky {
+    /// The sky a scene describes.
+    pub fn from_scene(scene: &Scene) -> Sky {
+        Sky {
+            radiance: SkyRadiance::from_scene(scene),
+            model: scene.sky.model,
+            air: Air::from_scene(scene),
+        }
+    }
+}
+
+/// Sun, sky and haze of one frame, before any viewpoint: the uniform of `environment.wgsl`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Environment {
     /// The sun.
@@ -156,20 +178,25 @@ pub struct Environment {
 }
 
 impl Environment {
-    /// The environment a scene describes.
-    pub fn from_scene(scene: &Scene) -> Environment {
-        let s = &scene.sun;
+    /// The environment of `sky` under a frame's `sun`.
+    pub fn new(sky: &Sky, sun: &FrameSun) -> Environment {
         Environment {
             sun: SunDisc {
-                direction: direction_from_angles_deg(s.elevation_deg, s.azimuth_deg),
-                irradiance: Vec3::from_array(s.color) * s.irradiance,
-                cos_radius: s.angular_radius_deg.to_radians().cos(),
+                direction: sun.direction,
+                irradiance: sun.irradiance,
+                cos_radius: sun.angular_radius_rad.cos(),
                 limb_darkening: SUN_LIMB_DARKENING,
             },
-            sky: SkyRadiance::from_scene(scene),
-            sky_model: scene.sky.model,
-            air: Air::from_scene(scene),
+            sky: sky.radiance,
+            sky_model: sky.model,
+            air: sky.air,
         }
+    }
+
+    /// The environment a scene describes, its sun included (for CPU work on a whole scene: the
+    /// path tracer, exports).
+    pub fn from_scene(scene: &Scene) -> Environment {
+        Environment::new(&Sky::from_scene(scene), &FrameSun::from_scene(&scene.sun))
     }
 }
 

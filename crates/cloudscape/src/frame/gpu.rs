@@ -1,6 +1,6 @@
 //! The frame on the GPU: one uniform in a bind group of its own, rewritten each frame.
 
-use super::Frame;
+use super::{Frame, FrameSettings};
 use crate::gpu::uniform::UniformGroup;
 use crate::output::SampleGrid;
 use bytemuck::{Pod, Zeroable};
@@ -30,16 +30,17 @@ pub struct FrameUniform {
 }
 
 impl FrameUniform {
-    /// The uniform of `frame` with a technique output sampled on `grid`.
-    pub fn new(frame: &Frame, grid: &SampleGrid) -> FrameUniform {
+    /// The uniform of `frame` with a technique output sampled on `grid`, and the renderer's
+    /// `settings`.
+    pub fn new(frame: &Frame, grid: &SampleGrid, settings: &FrameSettings) -> FrameUniform {
         FrameUniform {
             clip_from_world: frame.clip_from_world(),
             view_from_clip: frame.clip_from_view.inverse(),
             world_from_view: frame.view_from_world.inverse(),
             camera_position_m: frame.camera_position_m,
             far_m: frame.far_m,
-            ground_albedo: frame.ground_albedo.unwrap_or(Vec3::ZERO),
-            has_ground: frame.ground_albedo.is_some() as u32,
+            ground_albedo: settings.ground_albedo.unwrap_or(Vec3::ZERO),
+            has_ground: settings.ground_albedo.is_some() as u32,
             viewport_px: frame.size.as_vec2(),
             time_s: frame.time_s,
             frame_index: frame.frame_index,
@@ -48,14 +49,15 @@ impl FrameUniform {
             ray_offset_strata: grid.temporal_offset.unwrap_or(0.0),
             depth_far_value: frame.depth.far_value(),
             depth_reversed: frame.depth.is_reversed() as u32,
-            cloud_mean_cosine: frame.cloud_mean_cosine,
+            cloud_mean_cosine: settings.cloud_mean_cosine,
             temporal_ray_offsets: grid.temporal_offset.is_some() as u32,
         }
     }
 }
 
 /// The frame's uniform buffer and bind group ([`crate::shader::FRAME_GROUP`] in every program):
-/// `FrameGpu::new(ctx, "frame")`, then `write(ctx, &frame.uniform(&grid))` once per frame.
+/// `FrameGpu::new(ctx, "frame")`, then `write(ctx, &frame.uniform(&grid, &settings))` once per
+/// frame.
 pub type FrameGpu = UniformGroup<FrameUniform>;
 
 #[cfg(test)]

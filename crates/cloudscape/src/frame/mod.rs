@@ -1,8 +1,11 @@
-//! One frame's view: the camera and its projection, the host's depth convention, the ground, the
-//! scene time and the sampling grid of the technique's output, derived from a scene or given by a
-//! host renderer. [`FrameGpu`] uploads it once per frame into the one uniform every pass reads at
-//! bind group [`crate::shader::FRAME_GROUP`] (`frame.wgsl`). The light around the clouds (sun, sky,
-//! haze) is the environment's ([`crate::environment`]), not the frame's.
+//! One frame's inputs, as a host has them each frame: the camera and its projection, the host's
+//! depth convention, the sun, the clock and the exposure ([`Frame`]), derived from a scene
+//! ([`Frame::from_scene`]) or built by a host renderer from its own camera, light and time. What
+//! does not change from frame to frame (the ground's albedo, the droplets' phase function) is the
+//! renderer's settings ([`FrameSettings`]), read from the scene when it is built or edited.
+//! [`FrameGpu`] uploads both once per frame into the one uniform every pass reads at bind group
+//! [`crate::shader::FRAME_GROUP`] (`frame.wgsl`). The sky and haze around the clouds are the
+//! environment's ([`crate::environment`]).
 
 mod depth;
 mod gpu;
@@ -14,7 +17,7 @@ pub use shared::{Shared, SharedSlots};
 
 use crate::optics::PhaseLobes;
 use crate::output::SampleGrid;
-use crate::scene::Scene;
+use crate::scene::{Camera, Scene, Sun};
 use glam::{Mat4, UVec2, Vec3};
 
 /// Unit vector toward elevation `el` and azimuth `az` (degrees; azimuth clockwise from north, with
@@ -28,7 +31,54 @@ pub fn direction_from_angles_deg(elevation_deg: f32, azimuth_deg: f32) -> Vec3 {
 /// pixel's ray: between the near and far planes in every [`DepthConvention`].
 const RAY_NDC_DEPTH: f32 = 0.5;
 
-/// A frame's camera, ground and sampling.
+/// The sun as a host lights one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameSun {
+    /// Unit vector toward the centre of the sun's disc (world space: x east, y up, z south).
+    pub direction: Vec3,
+    /// Irradiance on a surface facing the sun, linear RGB (in the scene's radiometric unit); above
+    /// the air when the sky is the atmosphere, which reddens it on the way down.
+    pub irradiance: Vec3,
+    /// Angular radius of the disc, radians.
+    pub angular_radius_rad: f32,
+}
+
+impl FrameSun {
+    /// The sun a scene's `[sun]` table describes.
+    pub fn from_scene(sun: &Sun) -> FrameSun {
+        FrameSun {
+            direction: direction_from_angles_deg(sun.elevation_deg, sun.azimuth_deg),
+            irradiance: Vec3::from_array(sun.color) * sun.irradiance,
+            angular_radius_rad: sun.angular_radius_deg.to_radians(),
+        }
+    }
+}
+
+/// What the frame uniform holds that does not change from frame to frame: read from the scene when
+/// a renderer is built or edited.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameSettings {
+    /// Lambertian ground albedo; None without a ground.
+    pub ground_albedo: Option<Vec3>,
+    /// Mean cosine `g` of the cloud droplets' phase function: how far diffuse light gets through
+    /// clouds (their transport optical depth is `(1 - g) tau`).
+    pub cloud_mean_cosine: f32,
+}
+
+impl FrameSettings {
+    /// The settings a scene gives.
+    pub fn from_scene(scene: &Scene) -> FrameSettings {
+        FrameSettings {
+            ground_albedo: scene
+                .ground
+                .enabled
+                .then(|| Vec3::from_array(scene.ground.albedo)),
+            cloud_mean_cosine: PhaseLobes::from_scene(&scene.phase).mean_cosine(),
+        }
+    }
+}
+
+/// One frame's inputs: what a host has each frame (camera, depth convention, sun, clock, exposure).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
     /// Image size in pixels.
@@ -43,21 +93,31 @@ pub struct Frame {
     pub depth: DepthConvention,
     /// Nothing beyond this distance is marched, metres.
     pub far_m: f32,
-    /// Lambertian ground albedo; None without a ground.
-    pub ground_albedo: Option<Vec3>,
-    /// Mean cosine `g` of the cloud droplets' phase function: how far diffuse light gets through
-    /// clouds (their transport optical depth is `(1 - g) tau`).
-    pub cloud_mean_cosine: f32,
-    /// Scene time, seconds.
+    /// The sun.
+    pub sun: FrameSun,
+    /// Scene time, seconds: the wind has carried the clouds `time_s` times its speed.
     pub time_s: f32,
+    /// Exposure compensation of the tone-mapped image, stops.
+    pub exposure_ev: f32,
     /// Frame counter that decorrelates the sampling jitter of successive frames.
     pub frame_index: u32,
 }
 
 impl Frame {
-    /// The frame a scene describes, at `size` pixels, with a standard depth buffer.
+    /// The frame a scene describes (its camera, sun, time and exposure), at `size` pixels, with a
+    /// standard depth buffer.
     pub fn from_scene(scene: &Scene, size: UVec2) -> Frame {
-        let c = &scene.camera;
+        Frame {
+            time_s: scene.render.time_s,
+            exposure_ev: scene.render.exposure_ev,
+            ..Frame::of_camera(&scene.camera, size, FrameSun::from_scene(&scene.sun))
+        }
+    }
+
+    /// The view through `camera` (its place, direction, field of view and planes) at `size`
+    /// pixels, with a standard depth buffer, lit by `sun`; at time 0, exposure 0, frame 0.
+    pub fn of_camera(camera: &Camera, size: UVec2, sun: FrameSun) -> Frame {
+        let c = camera;
         let eye = Vec3::from_array(c.position_m);
         let forward = match c.look_at_m {
             Some(target) => (Vec3::from_array(target) - eye).normalize_or(Vec3::NEG_Z),
@@ -77,12 +137,9 @@ impl Frame {
             clip_from_view: depth.perspective(c.fov_y_deg.to_radians(), aspect, c.near_m, c.far_m),
             depth,
             far_m: c.far_m,
-            ground_albedo: scene
-                .ground
-                .enabled
-                .then(|| Vec3::from_array(scene.ground.albedo)),
-            cloud_mean_cosine: PhaseLobes::from_scene(&scene.phase).mean_cosine(),
-            time_s: scene.render.time_s,
+            sun,
+            time_s: 0.0,
+            exposure_ev: 0.0,
             frame_index: 0,
         }
     }
@@ -136,9 +193,10 @@ impl Frame {
         self.view_point(pixel, depth).length()
     }
 
-    /// The `Frame` uniform of `frame.wgsl` for a technique output sampled on `grid`.
-    pub fn uniform(&self, grid: &SampleGrid) -> FrameUniform {
-        FrameUniform::new(self, grid)
+    /// The `Frame` uniform of `frame.wgsl` for a technique output sampled on `grid`, with the
+    /// renderer's `settings`.
+    pub fn uniform(&self, grid: &SampleGrid, settings: &FrameSettings) -> FrameUniform {
+        FrameUniform::new(self, grid, settings)
     }
 }
 

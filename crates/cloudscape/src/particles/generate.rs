@@ -15,6 +15,7 @@ use super::grid::{CELL_JITTER, Column, RingGrid, smoothstep};
 use crate::environment::Environment;
 use crate::field::noise::{hash_to_unit, pcg_hash};
 use crate::field::{CloudField, GOLDEN_RATIO_CONJUGATE};
+use crate::frame::Frame;
 use crate::scene::{PlanetShape, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
@@ -98,6 +99,16 @@ impl Generation {
             sigma_max_per_m: super::ParticleTableSpec::from_scene(scene).extinction_per_m,
             particle_mean_density,
             occlusion_early_exit: scene.particles.occlusion_early_exit,
+        }
+    }
+
+    /// The same generation seen from `frame`: its camera, sun and time.
+    pub fn for_frame(self, frame: &Frame) -> Generation {
+        Generation {
+            camera_m: frame.camera_position_m,
+            sun_direction: frame.sun.direction,
+            time_s: frame.time_s,
+            ..self
         }
     }
 }

@@ -7,6 +7,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, Vec4};
+use std::path::Path;
 
 use super::ParticleTableSpec;
 use super::blend::Blending;
@@ -14,6 +15,7 @@ use super::generate::{Generation, Particle};
 use super::generate_gpu::{GenerationCounts, MAX_PARTICLES, ParticleGenerator, set_groups};
 use super::store::TableStore;
 use super::tables_gpu::ParticleTables;
+use crate::field::FieldError;
 use crate::frame::{Shared, SharedSlots};
 use crate::gpu::late_readback::LateReadback;
 use crate::gpu::pipeline::{
@@ -120,7 +122,11 @@ pub struct ParticleRenderer {
     generation_readback: LateReadback,
     store: TableStore,
     tables: Option<ParticleTables>,
+    /// The generation the scene asks for, from [`Technique::configure`]; each frame's camera, sun
+    /// and time make the frame's `generation`.
+    configured: Option<Generation>,
     generation: Option<Generation>,
+    still_divisor: u32,
     generator: Option<ParticleGenerator>,
     lists: Option<TileLists>,
     group: BindGroupCache,
@@ -129,8 +135,8 @@ pub struct ParticleRenderer {
 }
 
 impl ParticleRenderer {
-    /// Builds the passes against the shared groups' layouts; the tables and particle buffers are
-    /// made by the first [`Technique::prepare`] and [`Technique::encode`].
+    /// Builds the passes against the shared groups' layouts; the tables are loaded by
+    /// [`Technique::configure`], the particle buffers made by the first [`Technique::encode`].
     pub fn new(ctx: &GpuContext, shared: &Shared) -> ParticleRenderer {
         let read_only = storage_binding(true);
         let layout = bind_group_layout(
@@ -169,7 +175,9 @@ impl ParticleRenderer {
             generation_readback: LateReadback::new(ctx, "particle generation counts", 16),
             store: TableStore::user_cache(),
             tables: None,
+            configured: None,
             generation: None,
+            still_divisor: 1,
             generator: None,
             lists: None,
             group: BindGroupCache::default(),
@@ -282,17 +290,23 @@ impl Technique for ParticleRenderer {
         PASS_NAMES
     }
 
-    fn still_divisor(&self, scene: &Scene) -> u32 {
-        scene.particles.resolution_divisor
+    fn still_divisor(&self) -> u32 {
+        self.still_divisor
     }
 
-    fn prepare(&mut self, ctx: &GpuContext, inputs: &FrameInputs) {
-        let scene = inputs.scene;
+    fn configure(&mut self, ctx: &GpuContext, scene: &Scene, _: &Path) -> Result<(), FieldError> {
         let tables = self.load_tables(ctx, scene);
         let settings = Self::uniform(scene, tables);
         let generation = Generation::from_scene(scene, tables.mean_density);
         self.settings = settings;
-        self.generation = Some(generation);
+        self.configured = Some(generation);
+        self.still_divisor = scene.particles.resolution_divisor;
+        Ok(())
+    }
+
+    fn prepare(&mut self, _ctx: &GpuContext, inputs: &FrameInputs) {
+        let configured = self.configured.expect("configure comes before prepare");
+        self.generation = Some(configured.for_frame(inputs.frame));
         self.generated = false;
     }
 

@@ -2,6 +2,7 @@
 //! that writes, per output texel, the radiance the clouds scatter toward the eye, the transmittance
 //! through them and the cloud distance ([`crate::output`]), stopping at the host's depth buffer.
 
+use crate::field::FieldError;
 use crate::frame::{Shared, SharedSlots};
 use crate::gpu::GpuContext;
 use crate::gpu::PassTimer;
@@ -17,6 +18,7 @@ use crate::scene::{LightingModel, Quality, Scene};
 use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, Vec4};
+use std::path::Path;
 
 /// Shortest and longest path the march's light samples cover toward the sun, metres: to the top
 /// of the layers, within these bounds. Past 4 km of cumulus (optical depth ~ 200 at 0.05 m^-1) a
@@ -238,10 +240,12 @@ impl Technique for RaymarchRenderer {
         &["raymarch"]
     }
 
-    fn prepare(&mut self, ctx: &GpuContext, inputs: &FrameInputs) {
-        let scene = inputs.scene;
+    fn configure(&mut self, ctx: &GpuContext, scene: &Scene, _: &Path) -> Result<(), FieldError> {
         self.set_settings(ctx, &MarchSettings::from_scene(scene));
+        Ok(())
     }
+
+    fn prepare(&mut self, _: &GpuContext, _: &FrameInputs) {}
 
     fn encode(
         &mut self,

@@ -1,35 +1,28 @@
 //! The one place that knows every technique: builds the one a scene names.
 
-use std::path::Path;
-
-use crate::field::FieldError;
 use crate::frame::Shared;
 use crate::gpu::GpuContext;
 use crate::particles::render::ParticleRenderer;
 use crate::raymarch::RaymarchRenderer;
-use crate::scene::{Scene, Technique as TechniqueName};
+use crate::scene::Technique as TechniqueName;
 use crate::sprites::SpriteRenderer;
 use crate::technique::Technique;
 
-/// The technique `scene` names (`render.technique`), built against the shared groups; files it
-/// reads (a sprite model) resolve against `base_dir`, and one that cannot be read is an error at
-/// its scene key.
-pub fn build(
-    ctx: &GpuContext,
-    shared: &Shared,
-    scene: &Scene,
-    base_dir: &Path,
-) -> Result<Box<dyn Technique>, FieldError> {
-    Ok(match scene.render.technique {
+/// The technique `name` (`render.technique`), built against the shared groups; it draws once
+/// [`Technique::configure`] has given it a scene.
+pub fn build(ctx: &GpuContext, shared: &Shared, name: TechniqueName) -> Box<dyn Technique> {
+    match name {
         TechniqueName::Raymarch => Box::new(RaymarchRenderer::new(ctx, shared)),
         TechniqueName::Particles => Box::new(ParticleRenderer::new(ctx, shared)),
-        TechniqueName::Sprites => Box::new(SpriteRenderer::new(ctx, shared, scene, base_dir)?),
-    })
+        TechniqueName::Sprites => Box::new(SpriteRenderer::new(ctx, shared)),
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::Scene;
+    use std::path::Path;
 
     #[test]
     fn every_technique_is_dispatched_under_its_name() {
@@ -45,14 +38,15 @@ mod tests {
             environment: &environment,
         };
         for name in TechniqueName::ALL {
-            scene.render.technique = *name;
-            let built = build(&ctx, &shared, &scene, Path::new(".")).unwrap();
+            let mut built = build(&ctx, &shared, *name);
             assert_eq!(built.name(), name.name());
+            built.configure(&ctx, &scene, Path::new(".")).unwrap();
         }
         scene.sprites.model = Some("no-such-model.toml".into());
-        let error = build(&ctx, &shared, &scene, Path::new("."))
-            .err()
-            .expect("no file");
+        let mut sprites = build(&ctx, &shared, TechniqueName::Sprites);
+        let error = sprites
+            .configure(&ctx, &scene, Path::new("."))
+            .expect_err("no file");
         assert_eq!(error.key_path, "sprites.model");
         assert!(
             error.message.contains("no-such-model.toml"),

@@ -1,18 +1,21 @@
 //! [`CloudRenderer`]: one frame, any technique, on the host's device, depth buffer and scene colour.
 //!
-//! Per frame: [`CloudRenderer::begin_frame`] uploads the frame, environment, field time and the
-//! technique's settings; [`CloudRenderer::encode_clouds`] records the technique into the cloud
-//! output; [`CloudRenderer::encode_finish`] records temporal reuse (when asked for), composition
-//! over the host's colour (or the sky, sun and ground) and tone mapping. Nothing waits on the GPU;
+//! The scene is read when the renderer is built ([`CloudRenderer::new`]) and when it is edited
+//! ([`CloudRenderer::apply_edit`]): its field, its technique and their settings. Per frame the
+//! host passes only a [`Frame`] (camera, depth convention, sun, clock, exposure):
+//! [`CloudRenderer::begin_frame`] uploads the frame, the environment and the field's time;
+//! [`CloudRenderer::encode_clouds`] records the technique into the cloud output;
+//! [`CloudRenderer::encode_finish`] records temporal reuse (when asked for), composition over the
+//! host's colour (or the sky, sun and ground) and tone mapping. Nothing waits on the GPU;
 //! statistics come back a frame late ([`CloudRenderer::stats`]).
 
 use super::dispatch;
-use crate::environment::{Environment, EnvironmentGpu, EnvironmentPasses, EnvironmentUniform};
+use crate::environment::{Environment, EnvironmentGpu, EnvironmentPasses, EnvironmentUniform, Sky};
 pub use crate::field::gpu::FieldUpdate;
 
 use crate::field::gpu::FieldGpu;
 use crate::field::{CloudField, FieldError};
-use crate::frame::{Frame, FrameGpu, Shared};
+use crate::frame::{Frame, FrameGpu, FrameSettings, Shared};
 use crate::gpu::pipeline::{STORAGE_OUTPUT, texture_2d};
 use crate::gpu::{GpuContext, PassTimer};
 use crate::output::{CloudOutput, SampleGrid};
@@ -23,7 +26,7 @@ use crate::shadow::{BuiltShadow, ShadowParams, ShadowReuse};
 use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use crate::temporal::{TemporalResolve, TemporalSettings};
 use glam::{UVec2, Vec2};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Whether a frame reuses earlier frames.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -75,22 +78,40 @@ impl Targets {
 }
 
 /// Whether going from scene `previous` to `next` needs [`CloudRenderer::update_scene`]: a change of
-/// the cloud field (layers, weather, noise, volumes, planet), of the technique, or of the sprite
-/// technique's clouds. Every frame reads the rest (camera, sun, sky, shadow map, ground, phase
-/// function, lighting, particle settings, steps, exposure, tone mapping, time).
+/// the cloud field (layers, weather, noise, volumes, planet) or of the technique. Everything else
+/// is the technique's settings ([`crate::technique::Technique::configure`]) or the frame's.
 pub fn needs_update(previous: &Scene, next: &Scene) -> bool {
     fn rebuilt(s: &Scene) -> impl PartialEq + '_ {
         (
             (&s.layers, &s.weather, &s.noise, &s.volumes, &s.planet),
-            (s.render.technique, &s.sprites, &s.sprite_clouds),
+            s.render.technique,
         )
     }
     rebuilt(previous) != rebuilt(next)
 }
 
+/// `scene` without what a [`Frame`] carries (camera, sun, time, exposure, image size, animation):
+/// what a renderer is configured from.
+fn settings_of(scene: &Scene) -> Scene {
+    let defaults = Scene::default();
+    let mut settings = scene.clone();
+    settings.camera = defaults.camera;
+    settings.sun = defaults.sun;
+    settings.animation = defaults.animation;
+    let render = &mut settings.render;
+    (render.time_s, render.exposure_ev) = (defaults.render.time_s, defaults.render.exposure_ev);
+    (render.width, render.height) = (defaults.render.width, defaults.render.height);
+    settings
+}
+
 /// Clouds for a host renderer: the field, the shared frame state, the scene's technique and the
 /// shared passes, made once.
 pub struct CloudRenderer {
+    /// The scene drawn, without its frame inputs ([`settings_of`]); files resolve against `base_dir`.
+    settings: Scene,
+    base_dir: PathBuf,
+    sky: Sky,
+    frame_settings: FrameSettings,
     field: CloudField,
     field_gpu: FieldGpu,
     frame_gpu: FrameGpu,
@@ -115,7 +136,7 @@ pub struct CloudRenderer {
 
 impl CloudRenderer {
     /// Builds the field of `scene` (files resolve against `base_dir`), the technique it names and
-    /// every pass.
+    /// every pass, configured from the scene's settings.
     pub fn new(
         ctx: &GpuContext,
         scene: &Scene,
@@ -130,11 +151,16 @@ impl CloudRenderer {
             frame: &frame_gpu,
             environment: &environment_gpu,
         };
-        let technique = dispatch::build(ctx, &shared, scene, base_dir)?;
+        let mut technique = dispatch::build(ctx, &shared, scene.render.technique);
+        technique.configure(ctx, scene, base_dir)?;
         let environment_passes = EnvironmentPasses::new(ctx, &shared);
         let compositor = Compositor::new(ctx, &shared);
         let upsampler = Upsampler::new(ctx, &shared);
         Ok(CloudRenderer {
+            settings: settings_of(scene),
+            base_dir: base_dir.to_path_buf(),
+            sky: Sky::from_scene(scene),
+            frame_settings: FrameSettings::from_scene(scene),
             field,
             field_gpu,
             frame_gpu,
@@ -155,10 +181,31 @@ impl CloudRenderer {
         })
     }
 
-    /// Takes a live edit of `scene`: a new cloud field (coverage, wind, types, weather, grids) is
-    /// uploaded without regenerating the noise unless its seed changed, and a new technique is
-    /// built only when `render.technique` changed. Lighting, sun and sky need no call: every
-    /// [`CloudRenderer::begin_frame`] reads them.
+    /// Takes a new `scene` (files resolve against `base_dir`) and rebuilds what it changed: a new
+    /// cloud field (coverage, wind, types, weather, grids) is uploaded without regenerating the
+    /// noise unless its seed changed, and a new technique is built only when `render.technique`
+    /// changed; any other change of settings only reconfigures the technique. Returns what the
+    /// field update did, or None when the field stayed. The scene's camera, sun, time and exposure
+    /// are the frame's ([`Frame::from_scene`]), not read here.
+    pub fn apply_edit(
+        &mut self,
+        ctx: &GpuContext,
+        scene: &Scene,
+        base_dir: &Path,
+    ) -> Result<Option<FieldUpdate>, FieldError> {
+        let settings = settings_of(scene);
+        if settings == self.settings && base_dir == self.base_dir {
+            return Ok(None);
+        }
+        if needs_update(&self.settings, scene) || base_dir != self.base_dir {
+            return self.update_scene(ctx, scene, base_dir).map(Some);
+        }
+        self.configure(ctx, scene, base_dir)?;
+        Ok(None)
+    }
+
+    /// Takes `scene` as a new cloud field (and technique, when it names another): what
+    /// [`CloudRenderer::apply_edit`] does when the field changed, done unconditionally.
     pub fn update_scene(
         &mut self,
         ctx: &GpuContext,
@@ -167,30 +214,28 @@ impl CloudRenderer {
     ) -> Result<FieldUpdate, FieldError> {
         self.field = CloudField::new(scene, base_dir)?;
         let update = self.field_gpu.update(ctx, &self.field);
-        // Sprite clouds are made from the field and the scene's hand-made clouds: remade too.
-        let sprites = scene.render.technique == crate::scene::Technique::Sprites;
-        if sprites || self.technique.name() != scene.render.technique.name() {
-            self.technique = dispatch::build(ctx, &self.shared(), scene, base_dir)?;
+        if self.technique.name() != scene.render.technique.name() {
+            self.technique = dispatch::build(ctx, &self.shared(), scene.render.technique);
         }
+        self.configure(ctx, scene, base_dir)?;
         self.shadow_built = None;
         self.reset_history();
         Ok(update)
     }
 
-    /// Takes a live edit from `previous` to `scene` and rebuilds only what depends on it: calls
-    /// [`CloudRenderer::update_scene`] when [`needs_update`] says so (returning what it did), and
-    /// nothing otherwise, as every frame reads the rest.
-    pub fn apply_edit(
+    /// Reads the settings of `scene` into the technique and the shared passes.
+    fn configure(
         &mut self,
         ctx: &GpuContext,
-        previous: &Scene,
         scene: &Scene,
         base_dir: &Path,
-    ) -> Result<Option<FieldUpdate>, FieldError> {
-        if !needs_update(previous, scene) {
-            return Ok(None);
-        }
-        self.update_scene(ctx, scene, base_dir).map(Some)
+    ) -> Result<(), FieldError> {
+        self.technique.configure(ctx, scene, base_dir)?;
+        self.settings = settings_of(scene);
+        self.base_dir = base_dir.to_path_buf();
+        self.sky = Sky::from_scene(scene);
+        self.frame_settings = FrameSettings::from_scene(scene);
+        Ok(())
     }
 
     /// The CPU field drawn (the specification the GPU follows).
@@ -216,6 +261,11 @@ impl CloudRenderer {
             .size
     }
 
+    /// The sun, sky and haze of the frame last begun (before any, of the scene's own sun).
+    pub fn environment(&self) -> &Environment {
+        &self.environment.0
+    }
+
     /// The technique in use.
     pub fn technique_name(&self) -> &'static str {
         self.technique.name()
@@ -239,10 +289,10 @@ impl CloudRenderer {
             .collect()
     }
 
-    /// Starts a frame: uploads `frame`, the scene's environment, the field's time and the
-    /// technique's settings, and picks this frame's sample grid. `frame.frame_index` must advance
+    /// Starts a frame: uploads `frame`, the environment its sun makes, the field's time and the
+    /// technique's view, and picks this frame's sample grid. `frame.frame_index` must advance
     /// every frame when `reuse` is temporal.
-    pub fn begin_frame(&mut self, ctx: &GpuContext, scene: &Scene, frame: &Frame, reuse: Reuse) {
+    pub fn begin_frame(&mut self, ctx: &GpuContext, frame: &Frame, reuse: Reuse) {
         if let Reuse::Temporal(settings) = reuse {
             if self
                 .temporal
@@ -255,7 +305,7 @@ impl CloudRenderer {
         let grid = match (reuse, &self.temporal) {
             (Reuse::Temporal(_), Some(t)) => t.grid(frame.frame_index),
             _ => {
-                let divisor = self.technique.still_divisor(scene);
+                let divisor = self.technique.still_divisor();
                 SampleGrid {
                     divisor,
                     subpixel: UVec2::splat((divisor - 1) / 2),
@@ -273,19 +323,19 @@ impl CloudRenderer {
         }
         self.targets.as_mut().expect("targets were just made").grid = grid;
         self.field_gpu.set_time(ctx, &self.field, frame.time_s);
-        self.frame_gpu.write(ctx, &frame.uniform(&grid));
-        let env = Environment::from_scene(scene);
-        let viewpoint = frame.camera_position_m;
-        let shadow = self.frame_shadow(scene, &env, frame);
-        self.environment_gpu
-            .resize_shadow_map(ctx, scene.shadow.resolution);
-        let uniform = EnvironmentUniform::new(&env, viewpoint, &shadow);
+        self.frame_gpu
+            .write(ctx, &frame.uniform(&grid, &self.frame_settings));
+        let env = Environment::new(&self.sky, &frame.sun);
+        let shadow = self.frame_shadow(&env, frame);
+        let shadow_texels = self.settings.shadow.resolution;
+        self.environment_gpu.resize_shadow_map(ctx, shadow_texels);
+        let uniform = EnvironmentUniform::new(&env, frame.camera_position_m, &shadow);
         self.environment_gpu.write(ctx, &uniform);
         self.environment = (env, true);
         let inputs = FrameInputs {
-            scene,
             field: &self.field,
             frame,
+            environment: &env,
             grid: &grid,
         };
         self.technique.prepare(ctx, &inputs);
@@ -295,12 +345,13 @@ impl CloudRenderer {
 
     /// The shadow map this frame reads: the one built before, when [`ShadowReuse`] allows it,
     /// else a new one (and the frame's environment passes build it).
-    fn frame_shadow(&mut self, scene: &Scene, env: &Environment, frame: &Frame) -> ShadowParams {
+    fn frame_shadow(&mut self, env: &Environment, frame: &Frame) -> ShadowParams {
         let sun = env.sun.direction;
+        let settings = &self.settings;
         let fresh = BuiltShadow {
-            params: ShadowParams::new(scene, &self.field, frame.camera_position_m, sun),
+            params: ShadowParams::new(settings, &self.field, frame.camera_position_m, sun),
             sun,
-            texels: scene.shadow.resolution,
+            texels: settings.shadow.resolution,
             time_s: frame.time_s,
         };
         let wind = self.wind_m_per_s();
@@ -382,12 +433,11 @@ impl CloudRenderer {
     }
 
     /// Records the rest of the frame: temporal reuse, composition over `background` with aerial
-    /// perspective, and tone mapping with the scene's exposure and operator.
+    /// perspective, and tone mapping with the frame's exposure and the scene's operator.
     pub fn encode_finish(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        scene: &Scene,
         background: &Background,
         mut timer: Option<&mut PassTimer>,
     ) {
@@ -428,7 +478,7 @@ impl CloudRenderer {
             &t.hdr_view,
             timed,
         );
-        let display = (scene.render.exposure_ev, scene.render.tonemap);
+        let display = (frame.exposure_ev, self.settings.render.tonemap);
         let views = (&t.hdr_view, &t.ldr_view, t.size);
         self.display.encode(ctx, encoder, views, display, timer);
     }
@@ -468,7 +518,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn only_the_field_the_technique_and_sprite_clouds_need_an_update() {
+    fn only_the_field_and_the_technique_need_an_update() {
         let base = Scene::default();
         let changed = |edit: fn(&mut Scene)| {
             let mut next = base.clone();
@@ -481,7 +531,7 @@ mod tests {
         assert!(changed(
             |s| s.render.technique = crate::scene::Technique::Sprites
         ));
-        assert!(changed(|s| s.sprites.cloud_size_m = 900.0));
+        assert!(!changed(|s| s.sprites.cloud_size_m = 900.0));
         assert!(!changed(|s| s.sun.elevation_deg = 5.0));
         assert!(!changed(|s| s.lighting.ambient_scale = 2.0));
         assert!(!changed(|s| s.render.quality = crate::scene::Quality::Low));

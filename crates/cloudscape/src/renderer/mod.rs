@@ -89,6 +89,8 @@ impl EmptyHost {
 pub struct SceneRenderer {
     clouds: CloudRenderer,
     host: Option<EmptyHost>,
+    /// The scene drawn by [`SceneRenderer::render`]: its settings and its frame.
+    scene: Scene,
 }
 
 impl SceneRenderer {
@@ -101,7 +103,21 @@ impl SceneRenderer {
         Ok(SceneRenderer {
             clouds: CloudRenderer::new(ctx, scene, base_dir)?,
             host: None,
+            scene: scene.clone(),
         })
+    }
+
+    /// Takes `scene` in place of the one drawn, rebuilding only what it changed
+    /// ([`CloudRenderer::apply_edit`]; returns what the field update did, if there was one).
+    pub fn set_scene(
+        &mut self,
+        ctx: &GpuContext,
+        scene: &Scene,
+        base_dir: &Path,
+    ) -> Result<Option<FieldUpdate>, FieldError> {
+        let update = self.clouds.apply_edit(ctx, scene, base_dir)?;
+        self.scene = scene.clone();
+        Ok(update)
     }
 
     /// The CPU field this renderer draws (the specification the GPU follows).
@@ -132,19 +148,15 @@ impl SceneRenderer {
         self.host.as_ref().expect("the host was just made")
     }
 
-    /// Renders `scene` as it describes itself (size, steps, exposure), calling `progress` with the
-    /// fraction done after each band of rows.
-    pub fn render(
-        &mut self,
-        ctx: &GpuContext,
-        scene: &Scene,
-        mut progress: impl FnMut(f32),
-    ) -> Rendered {
-        let size = UVec2::new(scene.render.width, scene.render.height);
-        let frame = Frame::from_scene(scene, size);
+    /// Renders the scene as it describes itself (its frame, size, steps, exposure), calling
+    /// `progress` with the fraction done after each band of rows.
+    pub fn render(&mut self, ctx: &GpuContext, mut progress: impl FnMut(f32)) -> Rendered {
+        let render = &self.scene.render;
+        let size = UVec2::new(render.width, render.height);
+        let frame = Frame::from_scene(&self.scene, size);
         self.host(ctx, &frame);
         let host = self.host.as_ref().expect("made above");
-        self.clouds.begin_frame(ctx, scene, &frame, Reuse::None);
+        self.clouds.begin_frame(ctx, &frame, Reuse::None);
         let output = self.clouds.output_size();
         for row in (0..output.y).step_by(TILE_ROWS as usize) {
             let band = (
@@ -160,7 +172,7 @@ impl SceneRenderer {
         }
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         self.clouds
-            .encode_finish(ctx, &mut encoder, scene, &host.background(), None);
+            .encode_finish(ctx, &mut encoder, &host.background(), None);
         ctx.queue.submit([encoder.finish()]);
         self.images(ctx)
     }
@@ -173,7 +185,6 @@ impl SceneRenderer {
     pub fn render_frame(
         &mut self,
         ctx: &GpuContext,
-        scene: &Scene,
         frame: &Frame,
         reuse: Reuse,
         timer: &mut PassTimer,
@@ -182,12 +193,12 @@ impl SceneRenderer {
         timer.reset();
         self.host(ctx, frame);
         let host = self.host.as_ref().expect("made above");
-        self.clouds.begin_frame(ctx, scene, frame, reuse);
+        self.clouds.begin_frame(ctx, frame, reuse);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         self.clouds
             .encode_clouds(ctx, &mut encoder, &host.depth, None, Some(timer));
         self.clouds
-            .encode_finish(ctx, &mut encoder, scene, &host.background(), Some(timer));
+            .encode_finish(ctx, &mut encoder, &host.background(), Some(timer));
         timer.resolve(&mut encoder);
         ctx.queue.submit([encoder.finish()]);
         ctx.wait_idle();

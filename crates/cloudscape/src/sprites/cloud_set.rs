@@ -14,6 +14,7 @@ use super::model::SpriteCloud;
 use super::shading::{self, ColorLevel, LEVELS, SunLight, physical_levels};
 use super::{CloudModel, ModelFile};
 use crate::field::{CloudField, FieldError};
+use crate::optics::PhaseLobes;
 use crate::particles::DEFAULT_EXTINCTION_PER_M;
 use crate::scene::{Scene, SpriteCloudSpec, SpriteLod};
 
@@ -96,7 +97,10 @@ pub struct CloudSet {
     tiling: Option<FieldTiling>,
     tiles: BTreeMap<TileKey, Option<SpriteCloud>>,
     scene_key: String,
-    sun: Vec3,
+    /// The light of the configured scene, toward the sun the groups were last lit by.
+    light: SunLight,
+    /// Extinction of clouds of no layer (hand-made), m^-1: the densest layer's.
+    default_extinction_per_m: f32,
     lod: SpriteLod,
     /// The sprites, cloud by cloud.
     pub sprites: Vec<GpuSprite>,
@@ -108,23 +112,16 @@ pub struct CloudSet {
     pub generation: u64,
 }
 
-impl CloudSet {
-    /// The set of `scene` with the hand-made and model-file clouds `authored` (with their levels,
-    /// None to derive them).
-    pub fn new(authored: Vec<(SpriteCloud, Option<[ColorLevel; LEVELS]>)>) -> CloudSet {
+impl Default for CloudSet {
+    /// An empty set, to be configured by [`CloudSet::configure`].
+    fn default() -> CloudSet {
         CloudSet {
-            authored: authored
-                .into_iter()
-                .map(|(cloud, levels)| Placed {
-                    cloud,
-                    levels,
-                    from_field: false,
-                })
-                .collect(),
+            authored: Vec::new(),
             tiling: None,
             tiles: BTreeMap::new(),
             scene_key: String::new(),
-            sun: Vec3::ZERO,
+            light: SunLight::default(),
+            default_extinction_per_m: DEFAULT_EXTINCTION_PER_M,
             lod: SpriteLod::Clusters,
             sprites: Vec::new(),
             clouds: Vec::new(),
@@ -132,33 +129,52 @@ impl CloudSet {
             generation: 0,
         }
     }
+}
+
+impl CloudSet {
+    /// Takes `scene`'s settings and its hand-made and model-file clouds `authored` (with their
+    /// levels, None to derive them, as [`authored_clouds`] reads them); when the clouds depend on
+    /// anything that changed, every cloud is made again by the next [`CloudSet::update`].
+    pub fn configure(&mut self, scene: &Scene, authored: &[Authored]) {
+        let key = scene_key(scene, authored);
+        if key == self.scene_key {
+            return;
+        }
+        self.scene_key = key;
+        self.authored = authored
+            .iter()
+            .map(|(cloud, levels)| Placed {
+                cloud: cloud.clone(),
+                levels: *levels,
+                from_field: false,
+            })
+            .collect();
+        self.tiles.clear();
+        self.sprites.clear();
+        self.clouds.clear();
+        self.lod = scene.sprites.lod;
+        self.tiling = scene.sprites.field_clouds.then_some(FieldTiling {
+            tile_m: scene.sprites.cloud_size_m,
+            distance_m: scene.sprites.distance_m,
+            time_s: 0.0,
+        });
+        let g = PhaseLobes::from_scene(&scene.phase).mean_cosine();
+        self.light = SunLight::from_scene(scene, Vec3::ZERO, g);
+        self.default_extinction_per_m = scene
+            .layers
+            .iter()
+            .map(|l| l.extinction_per_m)
+            .reduce(f32::max)
+            .unwrap_or(DEFAULT_EXTINCTION_PER_M);
+    }
 
     /// Brings the set to this frame: makes the field clouds of tiles the camera reached, forgets
     /// those it left, and relights the groups when the sun turned. Returns whether the records
     /// changed.
-    pub fn update(
-        &mut self,
-        field: &CloudField,
-        scene: &Scene,
-        camera_m: Vec3,
-        sun: Vec3,
-        g: f32,
-    ) -> bool {
-        let key = scene_key(scene);
-        if key != self.scene_key {
-            self.scene_key = key;
-            self.tiles.clear();
-            self.sprites.clear();
-            self.lod = scene.sprites.lod;
-            self.tiling = scene.sprites.field_clouds.then_some(FieldTiling {
-                tile_m: scene.sprites.cloud_size_m,
-                distance_m: scene.sprites.distance_m,
-                time_s: 0.0,
-            });
-        }
+    pub fn update(&mut self, field: &CloudField, camera_m: Vec3, sun: Vec3, time_s: f32) -> bool {
         let mut changed = self.sprites.is_empty() && self.clouds.is_empty();
         if let Some(tiling) = self.tiling.as_mut() {
-            tiling.time_s = scene.render.time_s;
+            tiling.time_s = time_s;
             let wanted = tiling.tiles_around(field, camera_m);
             let missing: Vec<TileKey> = wanted
                 .iter()
@@ -178,10 +194,11 @@ impl CloudSet {
                 self.tiles.insert(k, made.remove(&k));
             }
         }
-        let relight = self.sun.angle_between(sun) > SUN_TOLERANCE_RAD || self.sun == Vec3::ZERO;
+        let lit = self.light.sun;
+        let relight = lit.angle_between(sun) > SUN_TOLERANCE_RAD || lit == Vec3::ZERO;
         if changed || relight {
-            self.sun = sun;
-            self.rebuild(field, scene, g);
+            self.light.sun = sun;
+            self.rebuild(field);
             self.generation += 1;
             return true;
         }
@@ -189,7 +206,7 @@ impl CloudSet {
     }
 
     /// Lays every cloud out again.
-    fn rebuild(&mut self, field: &CloudField, scene: &Scene, g: f32) {
+    fn rebuild(&mut self, field: &CloudField) {
         let field_clouds = self.tiles.values().flatten().map(|cloud| Placed {
             cloud: cloud.clone(),
             levels: None,
@@ -199,13 +216,7 @@ impl CloudSet {
         self.sprites.clear();
         self.clouds.clear();
         self.cloud_centres.clear();
-        let default_extinction = scene
-            .layers
-            .iter()
-            .map(|l| l.extinction_per_m)
-            .reduce(f32::max)
-            .unwrap_or(DEFAULT_EXTINCTION_PER_M);
-        let light = SunLight::from_scene(scene, self.sun, g);
+        let (light, default_extinction) = (self.light, self.default_extinction_per_m);
         let laid: Vec<(GpuCloud, Vec<GpuSprite>)> = {
             use rayon::prelude::*;
             all.par_iter()
@@ -357,17 +368,13 @@ fn sprite_optical_depth(light: &SunLight, width_m: f32) -> f32 {
 }
 
 /// What the clouds depend on besides the camera, time and sun: a change rebuilds them all.
-fn scene_key(scene: &Scene) -> String {
+fn scene_key(scene: &Scene, authored: &[Authored]) -> String {
     format!(
         "{:?}",
         (
-            &scene.layers,
-            &scene.weather,
-            &scene.noise,
-            &scene.planet,
-            &scene.sprites,
-            &scene.sprite_clouds,
-            scene.phase.g,
+            (&scene.layers, &scene.weather, &scene.noise, &scene.planet),
+            (&scene.sprites, &scene.lighting, &scene.phase),
+            authored,
         )
     )
 }

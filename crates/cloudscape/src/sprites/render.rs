@@ -9,10 +9,13 @@ use std::path::Path;
 use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, Vec3, Vec4};
 
-use super::cloud_set::{CloudSet, GpuCloud, GpuSprite, authored_clouds};
+use super::cloud_set::{Authored, CloudSet, GpuCloud, GpuSprite, authored_clouds};
 use super::impostors::{ASPECT, SECTORS, SectorView};
 use super::textures::{SHEET_TEXELS, bake_sheet};
-use super::views::{Reach, SortedView, ViewUniform, sector_elevations, sort_view, wind_offsets_m};
+use super::views::{
+    Reach, SortedView, ViewSettings, ViewUniform, layer_winds_m_per_s, sector_elevations,
+    sort_view, wind_offsets_m,
+};
 use crate::field::FieldError;
 use crate::frame::{Shared, SharedSlots};
 use crate::gpu::pipeline::{
@@ -243,19 +246,33 @@ pub struct SpriteRenderer {
     resolve_groups: BindGroupCache,
     stats: SpriteStats,
     pixels: u32,
+    /// What [`Technique::configure`] took from the scene.
+    configured: Option<Configured>,
+    /// The hand-made and model-file clouds, with what they were read from (the scene's
+    /// `sprites.model`, `sprite_clouds` and directory): read again only when that changes.
+    authored: Option<(AuthoredSource, Vec<Authored>)>,
+}
+
+/// What the sprite clouds of a scene were read from.
+type AuthoredSource = (
+    Option<String>,
+    Vec<crate::scene::SpriteCloudSpec>,
+    std::path::PathBuf,
+);
+
+/// The scene's settings as the frames read them.
+#[derive(Clone, Copy)]
+struct Configured {
+    views: ViewSettings,
+    winds_m_per_s: [glam::Vec2; 4],
+    /// The settings uniform but for the frame's wind offsets.
+    uniform: SettingsUniform,
 }
 
 impl SpriteRenderer {
-    /// Builds the passes against the shared groups' layouts, bakes the puff sheet, and builds the
-    /// scene's hand-made clouds and those of its model file (`sprites.model`, relative to
-    /// `base_dir`; an unreadable or invalid file is a located error).
-    pub fn new(
-        ctx: &GpuContext,
-        shared: &Shared,
-        scene: &Scene,
-        base_dir: &Path,
-    ) -> Result<SpriteRenderer, FieldError> {
-        let authored = authored_clouds(scene, base_dir)?;
+    /// Builds the passes against the shared groups' layouts and bakes the puff sheet; the clouds
+    /// come with [`Technique::configure`].
+    pub fn new(ctx: &GpuContext, shared: &Shared) -> SpriteRenderer {
         let filterable = float_texture(wgpu::TextureViewDimension::D2);
         let sampler_type = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
         let read_only = storage_binding(true);
@@ -332,7 +349,7 @@ impl SpriteRenderer {
             "resolve_sprites",
             &shared.layouts(slots[2], &resolve_layout),
         );
-        Ok(SpriteRenderer {
+        SpriteRenderer {
             slots,
             sprite_layout,
             impostor_layout,
@@ -349,7 +366,7 @@ impl SpriteRenderer {
                 min_filter: wgpu::FilterMode::Linear,
                 ..Default::default()
             }),
-            set: CloudSet::new(authored),
+            set: CloudSet::default(),
             uploaded: None,
             main: ViewBuffers::new(ctx, "sprite view"),
             ring: None,
@@ -367,7 +384,9 @@ impl SpriteRenderer {
             resolve_groups: BindGroupCache::default(),
             stats: SpriteStats::default(),
             pixels: 0,
-        })
+            configured: None,
+            authored: None,
+        }
     }
 
     /// The counts of the newest frame.
@@ -419,13 +438,12 @@ impl SpriteRenderer {
     fn prepare_ring(
         &mut self,
         ctx: &GpuContext,
-        scene: &Scene,
+        views: &ViewSettings,
         eye: Vec3,
         time_s: f32,
         offsets: &[Vec4; 4],
     ) {
-        let radius = scene.sprites.ring_radius_m;
-        let texels = scene.sprites.impostor_texels;
+        let (radius, texels) = (views.ring_radius_m, views.impostor_texels);
         if radius <= 0.0 {
             self.ring = None;
             return;
@@ -466,7 +484,7 @@ impl SpriteRenderer {
                 (eye, sector.clip_from_world),
                 Reach::Beyond(radius),
             );
-            if ring.views[k].write(ctx, &ViewUniform::of_sector(&sector, scene), &sorted) {
+            if ring.views[k].write(ctx, &ViewUniform::of_sector(&sector, views), &sorted) {
                 ring.sector_groups[k] = None;
             }
             ring.sectors[k] = Some(sector);
@@ -621,32 +639,61 @@ impl Technique for SpriteRenderer {
         PASS_NAMES
     }
 
+    fn configure(
+        &mut self,
+        _ctx: &GpuContext,
+        scene: &Scene,
+        base_dir: &Path,
+    ) -> Result<(), FieldError> {
+        let source: AuthoredSource = (
+            scene.sprites.model.clone(),
+            scene.sprite_clouds.clone(),
+            base_dir.to_path_buf(),
+        );
+        if self
+            .authored
+            .as_ref()
+            .is_none_or(|(read, _)| *read != source)
+        {
+            self.authored = Some((source, authored_clouds(scene, base_dir)?));
+        }
+        let authored = &self.authored.as_ref().expect("read above").1;
+        self.set.configure(scene, authored);
+        self.configured = Some(Configured {
+            views: ViewSettings::of(&scene.sprites),
+            winds_m_per_s: layer_winds_m_per_s(scene),
+            uniform: SettingsUniform {
+                ambient_override: Vec3::from_array(scene.sprites.ambient_color.unwrap_or_default()),
+                ambient_overridden: scene.sprites.ambient_color.is_some() as u32,
+                directional_override: Vec3::from_array(
+                    scene.sprites.directional_color.unwrap_or_default(),
+                ),
+                directional_overridden: scene.sprites.directional_color.is_some() as u32,
+                phase_lobes: Vec4::from_array(PhaseLobes::from_scene(&scene.phase).to_gpu()),
+                albedo: scene.lighting.albedo,
+                ..SettingsUniform::zeroed()
+            },
+        });
+        Ok(())
+    }
+
     fn prepare(&mut self, ctx: &GpuContext, inputs: &FrameInputs) {
-        let (scene, frame) = (inputs.scene, inputs.frame);
+        let configured = self.configured.expect("configure comes before prepare");
+        let frame = inputs.frame;
         let eye = frame.camera_position_m;
-        let sun = crate::environment::Environment::from_scene(scene)
-            .sun
-            .direction;
         self.set
-            .update(inputs.field, scene, eye, sun, frame.cloud_mean_cosine);
+            .update(inputs.field, eye, frame.sun.direction, frame.time_s);
         self.upload_set(ctx);
-        let offsets = wind_offsets_m(scene, frame.time_s);
+        let offsets = wind_offsets_m(&configured.winds_m_per_s, frame.time_s);
         let settings = SettingsUniform {
             wind_offset_m: offsets,
-            ambient_override: Vec3::from_array(scene.sprites.ambient_color.unwrap_or_default()),
-            ambient_overridden: scene.sprites.ambient_color.is_some() as u32,
-            directional_override: Vec3::from_array(
-                scene.sprites.directional_color.unwrap_or_default(),
-            ),
-            directional_overridden: scene.sprites.directional_color.is_some() as u32,
-            phase_lobes: Vec4::from_array(PhaseLobes::from_scene(&scene.phase).to_gpu()),
-            albedo: scene.lighting.albedo,
-            ..SettingsUniform::zeroed()
+            ..configured.uniform
         };
         ctx.queue
             .write_buffer(&self.settings, 0, bytemuck::bytes_of(&settings));
-        let view = ViewUniform::of_frame(frame, inputs.grid, scene);
-        let reach = match scene.sprites.ring_radius_m {
+        let views = configured.views;
+        let view = ViewUniform::of_frame(frame, inputs.grid, &views);
+        let reach = match views.ring_radius_m {
             r if r > 0.0 => Reach::Within(r),
             _ => Reach::All,
         };
@@ -654,7 +701,7 @@ impl Technique for SpriteRenderer {
         if self.main.write(ctx, &view, &sorted) {
             self.main_group = None;
         }
-        self.prepare_ring(ctx, scene, eye, frame.time_s, &offsets);
+        self.prepare_ring(ctx, &views, eye, frame.time_s, &offsets);
         self.stats = SpriteStats {
             clouds: self.set.clouds.len() as u32,
             sprites: self.set.sprites.len() as u32,

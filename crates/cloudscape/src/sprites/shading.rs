@@ -97,7 +97,7 @@ pub struct GroupLight {
 }
 
 /// How sunlight reaches the groups: the sun, the octave model and the matter's optics.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SunLight {
     /// Unit vector toward the sun.
     pub sun: Vec3,

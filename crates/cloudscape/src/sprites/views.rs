@@ -9,7 +9,7 @@ use super::cloud_set::{CloudSet, GpuSprite, NO_LAYER};
 use super::impostors::{HALF_ANGLE_RAD, SectorView, sector_direction};
 use crate::frame::Frame;
 use crate::output::SampleGrid;
-use crate::scene::Scene;
+use crate::scene::{Scene, Sprites};
 
 /// Clouds fade out over this last fraction of `sprites.distance_m`.
 pub const FADE_FRACTION: f32 = 0.2;
@@ -28,14 +28,43 @@ pub struct ViewUniform {
     fade_end_m: f32,
 }
 
+/// What the views read of the scene's `[sprites]`, taken when the technique is configured.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewSettings {
+    /// Field clouds fade out over the last fifth of this horizontal distance, m.
+    pub distance_m: f32,
+    /// Sprites nearer than this face along the view, m.
+    pub lock_distance_m: f32,
+    /// Radius of the impostor ring, m (0: no ring).
+    pub ring_radius_m: f32,
+    /// Texels along each impostor's width.
+    pub impostor_texels: u32,
+}
+
+impl ViewSettings {
+    /// The settings of a scene's `[sprites]`.
+    pub fn of(sprites: &Sprites) -> ViewSettings {
+        ViewSettings {
+            distance_m: sprites.distance_m,
+            lock_distance_m: sprites.lock_distance_m,
+            ring_radius_m: sprites.ring_radius_m,
+            impostor_texels: sprites.impostor_texels,
+        }
+    }
+}
+
 /// The drift of each layer's wind frame at `time_s`, m (east, south), for the `Settings` uniform.
-pub fn wind_offsets_m(scene: &Scene, time_s: f32) -> [Vec4; 4] {
+pub fn wind_offsets_m(winds_m_per_s: &[Vec2; 4], time_s: f32) -> [Vec4; 4] {
+    winds_m_per_s.map(|wind| (wind * time_s).extend(0.0).extend(0.0))
+}
+
+/// The winds of the scene's first four layers, m/s (zero where there is no layer).
+pub fn layer_winds_m_per_s(scene: &Scene) -> [Vec2; 4] {
     std::array::from_fn(|i| {
-        let wind = scene
+        scene
             .layers
             .get(i)
-            .map_or(Vec2::ZERO, |l| Vec2::from_array(l.wind_m_per_s));
-        (wind * time_s).extend(0.0).extend(0.0)
+            .map_or(Vec2::ZERO, |l| Vec2::from_array(l.wind_m_per_s))
     })
 }
 
@@ -50,7 +79,7 @@ pub fn sprite_now(s: &GpuSprite, offsets: &[Vec4; 4]) -> Vec3 {
 impl ViewUniform {
     /// The frame's own view: its camera, the host-depth test, and the shift of the sample grid's
     /// rays to the output texels' centres.
-    pub fn of_frame(frame: &Frame, grid: &SampleGrid, scene: &Scene) -> ViewUniform {
+    pub fn of_frame(frame: &Frame, grid: &SampleGrid, sprites: &ViewSettings) -> ViewUniform {
         let forward = -frame
             .view_from_world
             .inverse()
@@ -61,13 +90,13 @@ impl ViewUniform {
         // Texel x of the output holds the ray through full pixel x d + s + 1/2, i.e. output
         // coordinate x + (s + 1/2) / d, where the raster samples x + 1/2.
         let shift = (grid.subpixel.as_vec2() + 0.5) / grid.divisor as f32 - 0.5;
-        let fade_end = scene.sprites.distance_m;
+        let fade_end = sprites.distance_m;
         ViewUniform {
             clip_from_world: frame.clip_from_world(),
             eye_m: frame.camera_position_m,
             host_depth_test: 1,
             forward,
-            lock_distance_m: scene.sprites.lock_distance_m,
+            lock_distance_m: sprites.lock_distance_m,
             target_offset_ndc: Vec2::new(-2.0 * shift.x / size.x, 2.0 * shift.y / size.y),
             fade_start_m: fade_end * (1.0 - FADE_FRACTION),
             fade_end_m: fade_end,
@@ -75,8 +104,8 @@ impl ViewUniform {
     }
 
     /// The view of an impostor sector: no host depth, no lock (the ring is far away).
-    pub fn of_sector(sector: &SectorView, scene: &Scene) -> ViewUniform {
-        let fade_end = scene.sprites.distance_m;
+    pub fn of_sector(sector: &SectorView, sprites: &ViewSettings) -> ViewUniform {
+        let fade_end = sprites.distance_m;
         ViewUniform {
             clip_from_world: sector.clip_from_world,
             eye_m: sector.eye_m,

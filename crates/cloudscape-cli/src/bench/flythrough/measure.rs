@@ -11,6 +11,7 @@ use cloudscape::renderer::{PASS_COUNT, Reuse, SceneRenderer};
 use cloudscape::scene::Scene;
 use glam::UVec2;
 use serde::Serialize;
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// The clock the marches are timed by.
@@ -128,6 +129,8 @@ type Lumas = [Vec<f32>; 3];
 pub struct Measurer<'a> {
     ctx: &'a GpuContext,
     renderer: SceneRenderer,
+    /// The directory the scene's files resolve against.
+    base_dir: PathBuf,
     timer: PassTimer,
     clock: Clock,
     temporal: Reuse,
@@ -136,17 +139,18 @@ pub struct Measurer<'a> {
 }
 
 impl<'a> Measurer<'a> {
-    /// Measures with `renderer`, timing by `clock`, marching `temporal` for the temporal march and
-    /// `reference` for the converged frames.
+    /// Measures with `renderer` (of a scene whose files resolve against `base_dir`), timing by
+    /// `clock`, marching `temporal` for the temporal march and `reference` for the converged frames.
     pub fn new(
         ctx: &'a GpuContext,
-        renderer: SceneRenderer,
+        (renderer, base_dir): (SceneRenderer, PathBuf),
         clock: Clock,
         (temporal, reference): (Reuse, ReferenceSteps),
     ) -> Measurer<'a> {
         Measurer {
             ctx,
             renderer,
+            base_dir,
             timer: PassTimer::new(ctx, PASS_COUNT),
             clock,
             temporal,
@@ -210,10 +214,20 @@ impl<'a> Measurer<'a> {
         (record, images)
     }
 
+    /// Makes `still` the renderer's scene. The stills of a fly-through differ from each other in
+    /// their frames and in the march's settings only (scenes whose coverage changes are refused),
+    /// which a renderer takes without reading a file.
+    fn show(&mut self, still: &Scene) {
+        self.renderer
+            .set_scene(self.ctx, still, &self.base_dir)
+            .expect("the fly-through changes only the march's settings");
+    }
+
     /// Renders one whole frame; its time (by the clock) in milliseconds and its display image.
     fn timed(&mut self, still: &Scene, frame: &Frame, reuse: Reuse) -> (f64, LdrImage) {
+        self.show(still);
         let (ctx, timer) = (self.ctx, &mut self.timer);
-        let wall = self.renderer.render_frame(ctx, still, frame, reuse, timer);
+        let wall = self.renderer.render_frame(ctx, frame, reuse, timer);
         let ms = match self.clock {
             Clock::Timestamps => timer.read_ms(ctx).iter().map(|(_, ms)| ms).sum(),
             Clock::Wall => wall.as_secs_f64() * 1e3,
@@ -226,8 +240,9 @@ impl<'a> Measurer<'a> {
         let mut reference = still.clone();
         reference.render.primary_steps = Some(self.reference.primary_steps);
         reference.render.samples_per_pixel = Some(self.reference.samples_per_pixel);
+        self.show(&reference);
         let start = Instant::now();
-        let images = self.renderer.render(self.ctx, &reference, progress);
+        let images = self.renderer.render(self.ctx, progress);
         (start.elapsed().as_secs_f64() * 1e3, images.ldr)
     }
 

@@ -68,7 +68,8 @@ pub fn run(mut args: BenchArgs) -> Result<()> {
     let scene = &doc.scene;
     let times = frame_times_s(scene, args.frames.unwrap_or(DEFAULT_FRAMES))?;
     let ctx = args.gpu.open(&doc)?;
-    let renderer = SceneRenderer::new(&ctx, scene, &doc.resolve_path(""))
+    let base_dir = doc.resolve_path("");
+    let renderer = SceneRenderer::new(&ctx, scene, &base_dir)
         .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
     let fly = &args.flythrough;
     let divisor = args.temporal.unwrap_or(DEFAULT_DIVISOR);
@@ -84,7 +85,7 @@ pub fn run(mut args: BenchArgs) -> Result<()> {
         reference: ReferenceSteps::new(scene, fly.reference_step_factor, fly.reference_spp),
     };
     let marches = (temporal_reuse(divisor), setup.reference);
-    let mut measurer = Measurer::new(&ctx, renderer, setup.clock, marches);
+    let mut measurer = Measurer::new(&ctx, (renderer, base_dir), setup.clock, marches);
     measurer.warm_up(&scene_at(scene, times[0]), args.warmup);
     let records = measure_all(&mut measurer, scene, &times, fly.out.as_deref())?;
     Report::new(setup, records).print(args.json)
