@@ -26,6 +26,27 @@ pub struct TechniqueStats {
     pub primitives: Option<u32>,
 }
 
+/// Which of a scene's clouds a technique draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Draws {
+    /// The cloud layers of the field (`[[layers]]`, or a METAR report's).
+    pub layers: bool,
+    /// Voxel grids (`[[volumes]]`).
+    pub voxel_grids: bool,
+    /// Hand-made sprite clouds (`[[sprite_clouds]]`) and sprite model files (`sprites.model`).
+    pub sprite_clouds: bool,
+}
+
+impl Draws {
+    /// Whether `scene` holds any cloud of a kind drawn.
+    pub fn any_of(&self, scene: &Scene) -> bool {
+        let sprite_clouds = !scene.sprite_clouds.is_empty() || scene.sprites.model.is_some();
+        (self.layers && !scene.layers.is_empty())
+            || (self.voxel_grids && !scene.volumes.is_empty())
+            || (self.sprite_clouds && sprite_clouds)
+    }
+}
+
 /// What a frame is made of, on the CPU: the field, the host's view, sun and clock, the environment
 /// they make and the sample grid of the output. Techniques that work on the CPU (generating
 /// particles, sprites) read the camera here, as the host set it. The scene is not here: a
@@ -57,6 +78,9 @@ pub trait Technique {
     /// The scene-file name (`render.technique`).
     fn name(&self) -> &'static str;
 
+    /// Which clouds it draws.
+    fn draws(&self) -> Draws;
+
     /// The labels its passes are timed under, in the order it records them.
     fn pass_names(&self) -> &'static [&'static str];
 
@@ -79,6 +103,19 @@ pub trait Technique {
 
     /// Takes this frame's view, sun and clock.
     fn prepare(&mut self, ctx: &GpuContext, inputs: &FrameInputs);
+
+    /// Records what a frame does once, before any of its rays: making its particles, rendering
+    /// impostors, clearing counters. The renderer calls it once per frame, before the frame's
+    /// first [`Technique::encode`]; its passes are timed under their own names.
+    fn encode_frame_setup(
+        &mut self,
+        _ctx: &GpuContext,
+        _encoder: &mut wgpu::CommandEncoder,
+        _shared: &Shared,
+        _targets: &TechniqueTargets,
+        _timer: Option<&mut PassTimer>,
+    ) {
+    }
 
     /// Records the technique over the output texels `region` (origin, size): the whole output, or
     /// one band of it when a long render reports progress (then submit each band before encoding

@@ -68,6 +68,8 @@ impl Harness {
         let region = (UVec2::ZERO, self.output.size);
         let shared = self.clouds.shared();
         self.particles
+            .encode_frame_setup(ctx, &mut encoder, &shared, &targets, None);
+        self.particles
             .encode(ctx, &mut encoder, &shared, &targets, region, None);
         self.particles.finish_frame(&mut encoder);
         ctx.queue.submit([encoder.finish()]);

@@ -60,15 +60,10 @@ impl Variant {
         label
     }
 
-    /// Whether the technique shows any of `scene`'s clouds: the particles and the sprites make
-    /// theirs from the field's layers (the sprites also from sprite-model clouds), not from voxel
-    /// grids, so a scene of voxel grids alone has nothing for them to be measured on.
+    /// Whether the technique shows any of `scene`'s clouds ([`cloudscape::renderer::draws`]): a
+    /// scene of voxel grids alone has nothing for the particles or the sprites to be measured on.
     pub fn shows_clouds_of(&self, scene: &Scene) -> bool {
-        match self.technique {
-            Technique::Raymarch => true,
-            Technique::Particles => !scene.layers.is_empty(),
-            Technique::Sprites => !scene.layers.is_empty() || !scene.sprite_clouds.is_empty(),
-        }
+        cloudscape::renderer::draws(self.technique).any_of(scene)
     }
 
     /// Whether this is how `scene` renders itself with `technique`.

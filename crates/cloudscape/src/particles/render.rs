@@ -27,7 +27,7 @@ use crate::gpu::{GpuContext, PassTimer};
 use crate::optics::PhaseLobes;
 use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
 use crate::scene::{PlanetShape, Scene};
-use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
+use crate::technique::{Draws, FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 
 /// Output texels along each side of a screen tile (`TILE` in `particle_render.wgsl`).
 pub const TILE_TEXELS: u32 = 16;
@@ -130,7 +130,6 @@ pub struct ParticleRenderer {
     generator: Option<ParticleGenerator>,
     lists: Option<TileLists>,
     group: BindGroupCache,
-    generated: bool,
     supplied: Option<Vec<Particle>>,
 }
 
@@ -181,7 +180,6 @@ impl ParticleRenderer {
             generator: None,
             lists: None,
             group: BindGroupCache::default(),
-            generated: false,
             supplied: None,
         }
     }
@@ -244,6 +242,45 @@ impl ParticleRenderer {
         }
     }
 
+    /// The technique's bind group for `targets` (made once per set of views).
+    fn bind_group(&mut self, ctx: &GpuContext, targets: &TechniqueTargets) -> wgpu::BindGroup {
+        let output = targets.output;
+        let (tables, generator, lists) = (
+            self.tables.as_ref().expect("configure loads the tables"),
+            self.generator.as_ref().expect("made by the frame's setup"),
+            self.lists.as_ref().expect("made by the frame's setup"),
+        );
+        let (layout, uniform, stats) = (&self.layout, &self.uniform, &self.stats);
+        let views = [targets.host_depth, &output.radiance, &output.distance];
+        self.group
+            .get(&views, || {
+                let od = &tables.optical_depth;
+                let od_view = od.texture.create_view(&Default::default());
+                let sc_view = tables.scattering.texture.create_view(&Default::default());
+                bind_group(
+                    &ctx.device,
+                    layout,
+                    &[
+                        uniform.as_entire_binding(),
+                        generator.particles.as_entire_binding(),
+                        generator.counts.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(&od_view),
+                        wgpu::BindingResource::Sampler(&od.sampler),
+                        od.chord_buffer.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(&sc_view),
+                        wgpu::BindingResource::Sampler(&tables.scattering.sampler),
+                        lists.counts.as_entire_binding(),
+                        lists.entries.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(targets.host_depth),
+                        wgpu::BindingResource::TextureView(&output.radiance),
+                        wgpu::BindingResource::TextureView(&output.distance),
+                        stats.as_entire_binding(),
+                    ],
+                )
+            })
+            .clone()
+    }
+
     /// Makes the tile lists fit `size` output texels.
     fn ensure_lists(&mut self, ctx: &GpuContext, size: UVec2) {
         let tiles = tile_grid(size);
@@ -281,9 +318,20 @@ impl ParticleRenderer {
     }
 }
 
+/// What the particles draw: the field's layers (not voxel grids, not sprite clouds).
+pub const DRAWS: Draws = Draws {
+    layers: true,
+    voxel_grids: false,
+    sprite_clouds: false,
+};
+
 impl Technique for ParticleRenderer {
     fn name(&self) -> &'static str {
         "particles"
+    }
+
+    fn draws(&self) -> Draws {
+        DRAWS
     }
 
     fn pass_names(&self) -> &'static [&'static str] {
@@ -307,7 +355,30 @@ impl Technique for ParticleRenderer {
     fn prepare(&mut self, _ctx: &GpuContext, inputs: &FrameInputs) {
         let configured = self.configured.expect("configure comes before prepare");
         self.generation = Some(configured.for_frame(inputs.frame));
-        self.generated = false;
+    }
+
+    fn encode_frame_setup(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        shared: &Shared,
+        targets: &TechniqueTargets,
+        timer: Option<&mut PassTimer>,
+    ) {
+        let generation = self.generation.expect("prepare comes before encoding");
+        if self.generator.as_ref().is_none_or(|g| !g.fits(&generation)) {
+            self.generator = Some(ParticleGenerator::new(ctx, shared, &generation));
+            self.group.clear();
+        }
+        let generator = self.generator.as_ref().expect("made above");
+        generator.set(ctx, &generation);
+        if let Some(particles) = &self.supplied {
+            generator.upload(ctx, particles);
+        }
+        self.ensure_lists(ctx, targets.output.size);
+        let group = self.bind_group(ctx, targets);
+        encoder.clear_buffer(&self.stats, 0, None);
+        self.encode_particles(encoder, shared, &group, timer);
     }
 
     fn encode(
@@ -319,22 +390,8 @@ impl Technique for ParticleRenderer {
         (origin, size): (UVec2, UVec2),
         timer: Option<(&mut PassTimer, &str)>,
     ) {
-        let generation = self.generation.expect("prepare comes before encode");
-        if self.generator.as_ref().is_none_or(|g| !g.fits(&generation)) {
-            self.generator = Some(ParticleGenerator::new(ctx, shared, &generation));
-            self.group.clear();
-        }
-        // Once a frame, not once a band: the particles are made by the frame's first band.
-        if !self.generated {
-            let generator = self.generator.as_ref().expect("made above");
-            generator.set(ctx, &generation);
-            if let Some(particles) = &self.supplied {
-                generator.upload(ctx, particles);
-            }
-        }
         let output = targets.output;
-        self.ensure_lists(ctx, output.size);
-        let lists = self.lists.as_ref().expect("made above");
+        let lists = self.lists.as_ref().expect("made by the frame's setup");
         let first_row = origin.y / TILE_TEXELS;
         let rows = (origin.y + size.y).div_ceil(TILE_TEXELS) - first_row;
         self.settings.grid_size = output.size;
@@ -344,48 +401,9 @@ impl Technique for ParticleRenderer {
         self.settings.band_rows = UVec2::new(origin.y, origin.y + size.y);
         ctx.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.settings));
-        let (tables, generator) = (
-            self.tables.as_ref().expect("prepare loads the tables"),
-            self.generator.as_ref().expect("made above"),
-        );
-        let (layout, uniform, stats) = (&self.layout, &self.uniform, &self.stats);
-        let views = [targets.host_depth, &output.radiance, &output.distance];
-        let group = self
-            .group
-            .get(&views, || {
-                let od = &tables.optical_depth;
-                let od_view = od.texture.create_view(&Default::default());
-                let sc_view = tables.scattering.texture.create_view(&Default::default());
-                bind_group(
-                    &ctx.device,
-                    layout,
-                    &[
-                        uniform.as_entire_binding(),
-                        generator.particles.as_entire_binding(),
-                        generator.counts.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(&od_view),
-                        wgpu::BindingResource::Sampler(&od.sampler),
-                        od.chord_buffer.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(&sc_view),
-                        wgpu::BindingResource::Sampler(&tables.scattering.sampler),
-                        lists.counts.as_entire_binding(),
-                        lists.entries.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(targets.host_depth),
-                        wgpu::BindingResource::TextureView(&output.radiance),
-                        wgpu::BindingResource::TextureView(&output.distance),
-                        stats.as_entire_binding(),
-                    ],
-                )
-            })
-            .clone();
-        let mut timer = timer.map(|(t, _)| t);
-        if !self.generated {
-            encoder.clear_buffer(&self.stats, 0, None);
-            self.encode_particles(encoder, shared, &group, timer.as_deref_mut());
-            self.generated = true;
-        }
-        let tiles_x = self.lists.as_ref().expect("made above").tiles.x;
-        let writes = timer.and_then(|t| t.compute_pass_writes(PASS_NAMES[2]));
+        let tiles_x = lists.tiles.x;
+        let group = self.bind_group(ctx, targets);
+        let writes = timer.and_then(|(t, _)| t.compute_pass_writes(PASS_NAMES[2]));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(PASS_NAMES[2]),
             timestamp_writes: writes,

@@ -15,7 +15,7 @@ use crate::gpu::pipeline::{
 use crate::optics::{Octaves, PhaseLobes, SunSlab};
 use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
 use crate::scene::{LightingModel, Quality, Scene};
-use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
+use crate::technique::{Draws, FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, Vec4};
 use std::path::Path;
@@ -174,7 +174,6 @@ pub struct RaymarchRenderer {
     sums: wgpu::Buffer,
     group: BindGroupCache,
     settings: MarchUniform,
-    stats_cleared: bool,
 }
 
 impl RaymarchRenderer {
@@ -210,7 +209,6 @@ impl RaymarchRenderer {
             sums: storage_buffer(ctx, "raymarch sums", size_of::<MarchSum>() as u64),
             group: BindGroupCache::default(),
             settings: MarchUniform::zeroed(),
-            stats_cleared: false,
         }
     }
 
@@ -231,9 +229,20 @@ impl RaymarchRenderer {
     }
 }
 
+/// What the ray marcher draws: the field, layers and voxel grids.
+pub const DRAWS: Draws = Draws {
+    layers: true,
+    voxel_grids: true,
+    sprite_clouds: false,
+};
+
 impl Technique for RaymarchRenderer {
     fn name(&self) -> &'static str {
         "raymarch"
+    }
+
+    fn draws(&self) -> Draws {
+        DRAWS
     }
 
     fn pass_names(&self) -> &'static [&'static str] {
@@ -247,6 +256,17 @@ impl Technique for RaymarchRenderer {
 
     fn prepare(&mut self, _: &GpuContext, _: &FrameInputs) {}
 
+    fn encode_frame_setup(
+        &mut self,
+        _: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        _: &Shared,
+        _: &TechniqueTargets,
+        _: Option<&mut PassTimer>,
+    ) {
+        encoder.clear_buffer(&self.stats, 0, None);
+    }
+
     fn encode(
         &mut self,
         ctx: &GpuContext,
@@ -256,10 +276,6 @@ impl Technique for RaymarchRenderer {
         (origin, size): (UVec2, UVec2),
         timer: Option<(&mut PassTimer, &str)>,
     ) {
-        if !self.stats_cleared {
-            encoder.clear_buffer(&self.stats, 0, None);
-            self.stats_cleared = true;
-        }
         if self.settings.tile_origin != origin || self.settings.tile_width != size.x {
             self.settings.tile_origin = origin;
             self.settings.tile_width = size.x;
@@ -299,7 +315,6 @@ impl Technique for RaymarchRenderer {
 
     fn finish_frame(&mut self, encoder: &mut wgpu::CommandEncoder) {
         self.stats_readback.copy(encoder, &self.stats);
-        self.stats_cleared = false;
     }
 
     fn stats(&mut self, ctx: &GpuContext) -> Option<TechniqueStats> {

@@ -6,7 +6,7 @@ use crate::particles::render::ParticleRenderer;
 use crate::raymarch::RaymarchRenderer;
 use crate::scene::Technique as TechniqueName;
 use crate::sprites::SpriteRenderer;
-use crate::technique::Technique;
+use crate::technique::{Draws, Technique};
 
 /// The technique `name` (`render.technique`), built against the shared groups; it draws once
 /// [`Technique::configure`] has given it a scene.
@@ -15,6 +15,15 @@ pub fn build(ctx: &GpuContext, shared: &Shared, name: TechniqueName) -> Box<dyn 
         TechniqueName::Raymarch => Box::new(RaymarchRenderer::new(ctx, shared)),
         TechniqueName::Particles => Box::new(ParticleRenderer::new(ctx, shared)),
         TechniqueName::Sprites => Box::new(SpriteRenderer::new(ctx, shared)),
+    }
+}
+
+/// Which clouds the technique `name` draws, without building it.
+pub fn draws(name: TechniqueName) -> Draws {
+    match name {
+        TechniqueName::Raymarch => crate::raymarch::DRAWS,
+        TechniqueName::Particles => crate::particles::render::DRAWS,
+        TechniqueName::Sprites => crate::sprites::render::DRAWS,
     }
 }
 
@@ -40,6 +49,7 @@ mod tests {
         for name in TechniqueName::ALL {
             let mut built = build(&ctx, &shared, *name);
             assert_eq!(built.name(), name.name());
+            assert_eq!(built.draws(), draws(*name));
             built.configure(&ctx, &scene, Path::new(".")).unwrap();
         }
         scene.sprites.model = Some("no-such-model.toml".into());

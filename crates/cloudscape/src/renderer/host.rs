@@ -119,6 +119,8 @@ pub struct CloudRenderer {
     environment_passes: EnvironmentPasses,
     /// The environment of the last frame begun, and whether its passes still need recording.
     environment: (Environment, bool),
+    /// Whether the technique's once-a-frame passes still need recording this frame.
+    technique_setup_pending: bool,
     technique: Box<dyn Technique>,
     temporal: Option<TemporalResolve>,
     upsampler: Upsampler,
@@ -167,6 +169,7 @@ impl CloudRenderer {
             environment_gpu,
             environment_passes,
             environment: (Environment::from_scene(scene), false),
+            technique_setup_pending: false,
             technique,
             temporal: None,
             upsampler,
@@ -339,6 +342,7 @@ impl CloudRenderer {
             grid: &grid,
         };
         self.technique.prepare(ctx, &inputs);
+        self.technique_setup_pending = true;
         self.frame = Some(frame.clone());
         self.reuse = reuse;
     }
@@ -404,6 +408,11 @@ impl CloudRenderer {
             host_depth,
             output: &t.output,
         };
+        if std::mem::take(&mut self.technique_setup_pending) {
+            let timed = timer.as_deref_mut();
+            self.technique
+                .encode_frame_setup(ctx, encoder, &shared, &targets, timed);
+        }
         let timer = timer.map(|t| (t, self.technique.name()));
         self.technique
             .encode(ctx, encoder, &shared, &targets, region, timer);

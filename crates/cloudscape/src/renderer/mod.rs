@@ -5,6 +5,7 @@
 mod dispatch;
 mod host;
 
+pub use dispatch::draws;
 pub use host::{CloudRenderer, FieldUpdate, FrameImages, Reuse, needs_update};
 
 use crate::field::{CloudField, FieldError};

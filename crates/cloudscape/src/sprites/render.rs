@@ -27,7 +27,7 @@ use crate::gpu::{GpuContext, PassTimer};
 use crate::optics::PhaseLobes;
 use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
 use crate::scene::Scene;
-use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
+use crate::technique::{Draws, FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 
 /// The timed passes of a frame, in order (the impostor pass only in frames that render one).
 pub const PASS_NAMES: &[&str] = &["sprites: impostors", "sprites: draw", "sprites: resolve"];
@@ -630,9 +630,21 @@ fn draw_sprites(
     }
 }
 
+/// What the sprites draw: clouds made from the field's layers, and hand-made and model-file
+/// sprite clouds (not voxel grids).
+pub const DRAWS: Draws = Draws {
+    layers: true,
+    voxel_grids: false,
+    sprite_clouds: true,
+};
+
 impl Technique for SpriteRenderer {
     fn name(&self) -> &'static str {
         "sprites"
+    }
+
+    fn draws(&self) -> Draws {
+        DRAWS
     }
 
     fn pass_names(&self) -> &'static [&'static str] {
@@ -711,6 +723,17 @@ impl Technique for SpriteRenderer {
         };
     }
 
+    fn encode_frame_setup(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        shared: &Shared,
+        _: &TechniqueTargets,
+        mut timer: Option<&mut PassTimer>,
+    ) {
+        self.encode_impostors(ctx, encoder, shared, &mut timer);
+    }
+
     fn encode(
         &mut self,
         ctx: &GpuContext,
@@ -721,7 +744,6 @@ impl Technique for SpriteRenderer {
         timer: Option<(&mut PassTimer, &str)>,
     ) {
         let mut timer = timer.map(|(t, _)| t);
-        self.encode_impostors(ctx, encoder, shared, &mut timer);
         let output = targets.output;
         if self.targets.as_ref().is_none_or(|t| t.size != output.size) {
             self.targets = Some(RasterTargets::single(ctx, output.size));
