@@ -73,47 +73,10 @@ pub fn up(planet: &PlanetGeometry, p: Vec3) -> Vec3 {
     }
 }
 
-/// Ray parameters `(t0, t1)` between which the line `origin + t dir` is below altitude
-/// `altitude_m` (inside the sphere of radius `R + h`, or under the plane `y = h`); infinite ends
-/// for a flat planet. None when it never is.
-pub fn below_altitude(
-    planet: &PlanetGeometry,
-    origin: Vec3,
-    dir: Vec3,
-    altitude_m: f32,
-) -> Option<(f64, f64)> {
-    let (o, d, h) = (origin.as_dvec3(), dir.as_dvec3(), f64::from(altitude_m));
-    match planet.shape {
-        PlanetShape::Flat => {
-            if d.y.abs() < 1e-12 {
-                return (o.y < h).then_some((f64::NEG_INFINITY, f64::INFINITY));
-            }
-            let t = (h - o.y) / d.y;
-            Some(if d.y > 0.0 {
-                (f64::NEG_INFINITY, t)
-            } else {
-                (t, f64::INFINITY)
-            })
-        }
-        PlanetShape::Spherical => {
-            let r = f64::from(planet.radius_m);
-            let b = o.dot(d) + d.y * r;
-            // |o - c|^2 - (R + h)^2 without cancellation: |o|^2 + 2 o.y R - h (2 R + h).
-            let c = o.length_squared() + 2.0 * o.y * r - h * (2.0 * r + h);
-            let disc = b * b - c;
-            if disc < 0.0 {
-                return None;
-            }
-            let s = disc.sqrt();
-            Some((-b - s, -b + s))
-        }
-    }
-}
-
 /// Distance along the ray to the ground (altitude 0), or infinity when it never gets there. A ray
 /// that starts below the ground is taken to hit it at once.
 pub fn ground_distance(planet: &PlanetGeometry, origin: Vec3, dir: Vec3) -> f32 {
-    match below_altitude(planet, origin, dir, 0.0) {
+    match planet.below(origin, dir, 0.0) {
         Some((t0, t1)) if t1 > 0.0 => t0.max(0.0) as f32,
         _ => f32::INFINITY,
     }
@@ -128,7 +91,7 @@ pub fn band_intervals(
     (bottom_m, top_m): (f32, f32),
     (t_min, t_max): (f32, f32),
 ) -> [Option<Interval>; 2] {
-    let Some((outer0, outer1)) = below_altitude(planet, origin, dir, top_m) else {
+    let Some((outer0, outer1)) = planet.below(origin, dir, top_m) else {
         return [None, None];
     };
     let span = |a: f64, b: f64| {
@@ -138,7 +101,7 @@ pub fn band_intervals(
         }
         .clip(t_min, t_max)
     };
-    match below_altitude(planet, origin, dir, bottom_m) {
+    match planet.below(origin, dir, bottom_m) {
         Some((inner0, inner1)) if inner1 > outer0 && inner0 < outer1 => {
             match (
                 span(outer0, inner0.max(outer0)),

@@ -51,6 +51,7 @@ pub const MODULES: &[WgslModule] = &[
         include_str!("atmosphere/atmosphere_aerial.wgsl"),
     ),
     module("cloud_shadow", include_str!("shadow/cloud_shadow.wgsl")),
+    module("march_light", include_str!("raymarch/march_light.wgsl")),
     module("raymarch", include_str!("raymarch/raymarch.wgsl")),
     module("upsample", include_str!("temporal/upsample.wgsl")),
     module("temporal", include_str!("temporal/temporal.wgsl")),
@@ -71,6 +72,10 @@ pub const MODULES: &[WgslModule] = &[
     module(
         "particle_generate",
         include_str!("particles/particle_generate.wgsl"),
+    ),
+    module(
+        "particle_blend",
+        include_str!("particles/particle_blend.wgsl"),
     ),
     module(
         "particle_render",

@@ -42,6 +42,7 @@ fn compare(scene: &Scene, base_dir: &std::path::Path, points: &[Vec3], time_s: f
             a: p.extend(1.0),
             b: Vec4::ZERO,
             c: Vec4::ZERO,
+            d: Vec4::ZERO,
         })
         .collect();
     let probe = Probe::new(&ctx, &clouds.shared());

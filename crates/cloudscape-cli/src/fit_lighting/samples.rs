@@ -9,10 +9,8 @@
 //! from the eye.
 
 use anyhow::{Result, anyhow};
-use cloudscape::field::CloudField;
-use cloudscape::raymarch::{MarchSettings, SUN_PATH_M, back_steps};
+use cloudscape::raymarch::{MarchSettings, back_steps, light};
 use cloudscape::scene::{Quality, SceneDocument};
-use cloudscape_reference::geometry::below_altitude;
 use cloudscape_reference::rng::Rng;
 use cloudscape_reference::sampling::uniform_sphere;
 use cloudscape_reference::{DEFAULT_MAJORANT_CELLS, PathTracer};
@@ -114,7 +112,9 @@ fn sample(
     let (origin, dir) = camera_ray((bottom_m, top_m), rng);
     let t = tracer.volume.free_flight(origin, dir, RAY_REACH_M, rng)?;
     let p = origin + dir * t;
-    let (tau_sun, tau_back) = light_paths(field, p, sun, (bottom_m, top_m), light_steps);
+    // The march's light samples, at the middle of each segment.
+    let tau_sun = light::sun_optical_depth(field, p, sun, (light_steps, 0.5), 0.0);
+    let tau_back = light::back_optical_depth(field, p, sun, (back_steps(light_steps), 0.5), 0.0);
     let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
     for _ in 0..paths {
         let v = f64::from(tracer.source_radiance(p, dir, rng).y);
@@ -132,32 +132,6 @@ fn sample(
         source: mean as f32,
         source_error: ((sum_sq / n - mean * mean).max(0.0) / n).sqrt() as f32,
     })
-}
-
-/// The optical depths of the march's light paths from `p` in the layers `(bottom_m, top_m)`:
-/// toward the sun to the top, and away from it to the bottom (or the top when the sun is below the
-/// horizon), each within [`SUN_PATH_M`]; `march_sun_optical_depth` and `march_back_optical_depth`
-/// in `raymarch.wgsl`, with their samples' offset at the middle of each segment.
-fn light_paths(
-    field: &CloudField,
-    p: Vec3,
-    sun: Vec3,
-    (bottom_m, top_m): (f32, f32),
-    light_steps: u32,
-) -> (f32, f32) {
-    let path = |dir: Vec3, length_m: f32, steps: u32| {
-        let length_m = length_m.clamp(SUN_PATH_M.0, SUN_PATH_M.1);
-        field.coarse_optical_depth((p, dir), (0.0, length_m, 2.0), (steps, 0.5), 0.0)
-    };
-    let exit_top =
-        |dir: Vec3| below_altitude(&field.planet, p, dir, top_m).map_or(0.0, |(_, t1)| t1 as f32);
-    let to_bottom = below_altitude(&field.planet, p, -sun, bottom_m)
-        .filter(|&(t0, t1)| t0 <= t1 && t0 > 0.0)
-        .map_or_else(|| exit_top(-sun), |(t0, _)| t0 as f32);
-    (
-        path(sun, exit_top(sun), light_steps),
-        path(-sun, to_bottom, back_steps(light_steps)),
-    )
 }
 
 /// A camera ray: from the ground looking up, from inside the layers, or from above looking down.

@@ -86,6 +86,39 @@ pub struct PlanetGeometry {
 }
 
 impl PlanetGeometry {
+    /// Ray parameters `(t0, t1)` between which the line `origin + t dir` is below altitude
+    /// `altitude_m` (inside the sphere of radius `R + h`, or under the plane `y = h`); infinite ends
+    /// for a flat planet. None when it never is. In f64: `field_below` in `field.wgsl` is the f32
+    /// twin, with a huge finite distance for the infinite ends and an empty interval for None.
+    pub fn below(&self, origin: Vec3, dir: Vec3, altitude_m: f32) -> Option<(f64, f64)> {
+        let (o, d, h) = (origin.as_dvec3(), dir.as_dvec3(), f64::from(altitude_m));
+        match self.shape {
+            PlanetShape::Flat => {
+                if d.y.abs() < 1e-12 {
+                    return (o.y < h).then_some((f64::NEG_INFINITY, f64::INFINITY));
+                }
+                let t = (h - o.y) / d.y;
+                Some(if d.y > 0.0 {
+                    (f64::NEG_INFINITY, t)
+                } else {
+                    (t, f64::INFINITY)
+                })
+            }
+            PlanetShape::Spherical => {
+                let r = f64::from(self.radius_m);
+                let b = o.dot(d) + d.y * r;
+                // |o - c|^2 - (R + h)^2 without cancellation: |o|^2 + 2 o.y R - h (2 R + h).
+                let c = o.length_squared() + 2.0 * o.y * r - h * (2.0 * r + h);
+                let disc = b * b - c;
+                if disc < 0.0 {
+                    return None;
+                }
+                let s = disc.sqrt();
+                Some((-b - s, -b + s))
+            }
+        }
+    }
+
     /// Altitude of `p` above the ground, metres. For the sphere (centre `(0, -R, 0)`) this is
     /// `(|p|^2 + 2 y R) / (|p - c| + R)`, algebraically `|p - c| - R` but free of the cancellation
     /// that loses metres in f32 at R = 6360 km.

@@ -52,6 +52,21 @@ fn frame_farther_depth(a: f32, b: f32) -> f32 {
     return select(max(a, b), min(a, b), frame.depth_reversed == 1u);
 }
 
+// The farthest depth over a block of `size` x `size` texels of a full-resolution host depth buffer
+// (clamped to the viewport): a low-resolution ray must not stop short of geometry that only part
+// of its block has (Yusov 2014).
+fn frame_block_depth(host_depth: texture_2d<f32>, block: vec2<u32>, size: u32) -> f32 {
+    var depth = 1.0 - frame.depth_far_value; // the nearest value: any geometry is farther
+    let full = vec2<u32>(frame.viewport_px);
+    for (var y = 0u; y < size; y++) {
+        for (var x = 0u; x < size; x++) {
+            let texel = min(block * size + vec2<u32>(x, y), full - 1u);
+            depth = frame_farther_depth(depth, textureLoad(host_depth, vec2<i32>(texel), 0).x);
+        }
+    }
+    return depth;
+}
+
 // Distance along the ray through `pixel` to what depth-buffer value `depth` stores; FIELD-style
 // 3e38 where it holds no geometry: Frame::depth_distance_m.
 fn frame_depth_distance(pixel: vec2<f32>, depth: f32) -> f32 {

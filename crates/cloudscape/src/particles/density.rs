@@ -4,7 +4,7 @@
 //!
 //! Positions are in particle space: the particle is the unit ball, density is 0 outside it and at
 //! most 1 inside. A real particle of radius `R` and peak extinction `sigma` has extinction
-//! `sigma * density(p / R)`. `particle_density` in `optical_depth.wgsl` is the GPU twin.
+//! `sigma * density(p / R)`. `particle_density_with_noise` in `particle.wgsl` is the GPU twin.
 
 use glam::{Vec2, Vec3};
 

@@ -276,7 +276,11 @@ pub fn sun_optical_depth(
         return (0.0, 0);
     };
     let sun = g.sun_direction;
-    let to_top = distance_below(field, p, sun, top);
+    // `field_below(p, sun, top).y`: where the path leaves the layers' top (0 if never below it).
+    let to_top = field
+        .planet
+        .below(p, sun, top)
+        .map_or(0.0, |(_, t1)| t1 as f32);
     let length_m = (to_top.min(OCCLUSION_PATH_M) - radius_m).max(0.0);
     let total = ((1u32 << OCCLUSION_STEPS) - 1) as f32;
     let (mut width, mut start, mut tau) = (length_m / total, radius_m, 0.0);
@@ -291,21 +295,6 @@ pub fn sun_optical_depth(
         width *= 2.0;
     }
     (tau, OCCLUSION_STEPS)
-}
-
-/// Distance along `dir` from `p` (below altitude `h`) to altitude `h`: `field_below(p, dir, h).y`.
-fn distance_below(field: &CloudField, p: Vec3, dir: Vec3, h: f32) -> f32 {
-    match field.planet.shape {
-        PlanetShape::Flat if dir.y > 1e-8 => (h - p.y) / dir.y,
-        PlanetShape::Flat => f32::MAX,
-        PlanetShape::Spherical => {
-            let r = field.planet.radius_m;
-            let b = p.dot(dir) + dir.y * r;
-            let c = p.dot(p) + 2.0 * p.y * r - h * (2.0 * r + h);
-            let disc = b * b - c;
-            if disc < 0.0 { 0.0 } else { -b + disc.sqrt() }
-        }
-    }
 }
 
 /// Both steps over the whole grid: every particle around the camera, in no particular order.

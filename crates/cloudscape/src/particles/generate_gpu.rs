@@ -292,5 +292,20 @@ mod tests {
                 reserved,
             }
         );
+        assert_wgsl_layout!(
+            "particle_generate",
+            "ListedCell",
+            crate::particles::generate::ListedCell { column, layers }
+        );
+        assert_wgsl_layout!(
+            "particle_render",
+            "ParticleShape",
+            crate::particles::density::ParticleShape {
+                base_cells,
+                a,
+                b,
+                c
+            }
+        );
     }
 }

@@ -13,7 +13,7 @@
 //! direction zeniths per direction azimuth); the hardware filters the first three coordinates and
 //! the look-up interpolates between two slices by hand across the fourth, as the seed describes.
 //! This module is the CPU specification: the parameterisation, the bake and the look-up, which the
-//! GPU twins (`optical_depth.wgsl`, [`super::gpu`]) must match.
+//! GPU twins (`particle.wgsl`, [`super::gpu`]) must match.
 
 use glam::{IVec3, UVec3, Vec2, Vec3, Vec4};
 use half::f16;
@@ -230,7 +230,7 @@ impl OpticalDepthTable {
     /// Optical mass (particle radii) along the chord entering the unit sphere at `entry` along
     /// `dir` (unit), in the particle's own orientation (apply a particle's random rotation to both
     /// before calling). Trilinear across the texture's three axes and linear across direction
-    /// azimuth, exactly as `particle_optical_depth_taps` in `optical_depth.wgsl` samples the
+    /// azimuth, exactly as `particle_optical_depth_taps` in `particle.wgsl` samples the
     /// texture.
     pub fn lookup(&self, entry: Vec3, dir: Vec3) -> f32 {
         let taps = LookupTaps::new(&self.layout, entry, dir);

@@ -1,4 +1,4 @@
-#import frame environment phase particle particle_lookup
+#import frame environment phase particle particle_lookup particle_blend
 // Particle rendering in compute (particles/render.rs): the particles of particle_generate.wgsl
 // binned into screen tiles (`bin_particles`, one invocation per particle), then one workgroup per
 // tile (`render_tiles`) that sorts the tile's list by distance and blends, per pixel, the segment of
@@ -208,75 +208,28 @@ fn sort_tile_keys(size: u32, lane: u32) {
     }
 }
 
-// The seed's per-pixel record (particles/blend.rs Segment).
-struct Segment {
-    near_m: f32,
-    far_m: f32,
-    optical_depth: f32,
-    colour: vec3<f32>,
-}
-
-fn segment_density(s: Segment) -> f32 {
-    return s.optical_depth / max(s.far_m - s.near_m, 1e-6);
-}
-
-// blend::merge.
-fn merge(a: Segment, b: Segment) -> Segment {
-    var first = a;
-    var second = b;
-    if b.near_m < a.near_m {
-        first = b;
-        second = a;
-    }
-    let rho_first = segment_density(first);
-    let rho_second = segment_density(second);
-    let front_m = min(second.near_m, first.far_m) - first.near_m;
-    let isec_m = max(min(first.far_m, second.far_m) - second.near_m, 0.0);
-    var back = second;
-    var back_m = second.far_m - max(first.far_m, second.near_m);
-    if first.far_m > second.far_m {
-        back = first;
-        back_m = first.far_m - second.far_m;
-    }
-    let t_front = exp(-rho_first * front_m);
-    let rho_isec = rho_first + rho_second;
-    let t_isec = exp(-rho_isec * isec_m);
-    let t_back = exp(-segment_density(back) * back_m);
-    var isec_colour = first.colour;
-    if rho_isec > 0.0 {
-        isec_colour = (first.colour * rho_first + second.colour * rho_second) / rho_isec;
-    }
-    let premultiplied = first.colour * (1.0 - t_front) + isec_colour * (1.0 - t_isec) * t_front + back.colour * (1.0 - t_back) * t_front * t_isec;
-    let t = t_front * t_isec * t_back;
-    var colour = isec_colour;
-    if t < 1.0 {
-        colour = premultiplied / (1.0 - t);
-    }
-    return Segment(first.near_m, max(first.far_m, second.far_m), a.optical_depth + b.optical_depth, colour);
-}
-
 // blend::PixelBlend.
 struct PixelBlend {
     has_record: bool,
-    record: Segment,
+    record: BlendSegment,
     radiance: vec3<f32>,
     transmittance: f32,
     distance_weighted_m: f32,
 }
 
-fn blend_segment(pixel: ptr<function, PixelBlend>, s: Segment) {
+fn blend_segment(pixel: ptr<function, PixelBlend>, s: BlendSegment) {
     let opacity = 1.0 - exp(-s.optical_depth);
     (*pixel).radiance += (*pixel).transmittance * opacity * s.colour;
     (*pixel).distance_weighted_m += (*pixel).transmittance * opacity * 0.5 * (s.near_m + s.far_m);
     (*pixel).transmittance *= 1.0 - opacity;
 }
 
-fn blend_add(pixel: ptr<function, PixelBlend>, s: Segment) {
+fn blend_add(pixel: ptr<function, PixelBlend>, s: BlendSegment) {
     if !(*pixel).has_record {
         (*pixel).record = s;
         (*pixel).has_record = true;
     } else if render.blending == VOLUME_AWARE && s.near_m < (*pixel).record.far_m {
-        (*pixel).record = merge((*pixel).record, s);
+        (*pixel).record = blend_merge((*pixel).record, s);
     } else {
         blend_segment(pixel, (*pixel).record);
         (*pixel).record = s;
@@ -304,8 +257,8 @@ struct Light {
 // 0 where it misses. The ellipsoid maps to the unit sphere by dividing by its radii; a chord the
 // camera or the host's depth clips keeps its share of the whole chord's optical depth (uniform
 // density, as the blending assumes).
-fn particle_segment(p: Particle, o: vec3<f32>, d: vec3<f32>, t_max: f32, light: Light) -> Segment {
-    var none = Segment(0.0, 0.0, 0.0, vec3<f32>(0.0));
+fn particle_segment(p: Particle, o: vec3<f32>, d: vec3<f32>, t_max: f32, light: Light) -> BlendSegment {
+    var none = BlendSegment(0.0, 0.0, 0.0, vec3<f32>(0.0));
     let radii = vec3<f32>(p.radius_m, p.height_m, p.radius_m);
     let lo = (o - p.centre_m) / radii;
     let ld = d / radii;
@@ -341,7 +294,7 @@ fn particle_segment(p: Particle, o: vec3<f32>, d: vec3<f32>, t_max: f32, light: 
     let sun = light.sun * (light.phase * single * exp(-p.sun_optical_depth) + multiple * exp(-MULTIPLE_OCCLUSION * p.sun_optical_depth));
     let share_from_below = frame_two_stream_share_from_below(p.optical_depth_up, p.optical_depth_down);
     let ambient = render.ambient_scale * mix(light.sky_above, light.from_below, share_from_below);
-    return Segment(near_m, far_m, optical_depth, sun + render.albedo * ambient);
+    return BlendSegment(near_m, far_m, optical_depth, sun + render.albedo * ambient);
 }
 
 // Distance to the ground along the ray (3e38 without one): field_ground_distance, for the planet
@@ -362,20 +315,6 @@ fn ground_distance(o: vec3<f32>, d: vec3<f32>) -> f32 {
     }
     let t = -b - sqrt(disc);
     return select(3.0e38, max(t, 0.0), -b + sqrt(disc) > 0.0);
-}
-
-// The farthest host depth over a block of the full-resolution depth buffer (raymarch.wgsl's
-// march_block_depth): a low-resolution ray must not stop short of geometry only part of it has.
-fn block_depth(block: vec2<u32>, size: u32) -> f32 {
-    var depth = 1.0 - frame.depth_far_value;
-    let full = vec2<u32>(frame.viewport_px);
-    for (var y = 0u; y < size; y++) {
-        for (var x = 0u; x < size; x++) {
-            let texel = min(block * size + vec2<u32>(x, y), full - 1u);
-            depth = frame_farther_depth(depth, textureLoad(host_depth, vec2<i32>(texel), 0).x);
-        }
-    }
-    return depth;
 }
 
 @compute @workgroup_size(16, 16)
@@ -410,7 +349,7 @@ fn render_tiles(
     let o = frame.camera_position_m;
     let d = frame_ray_direction(pixel);
     var t_max = min(frame.far_m, ground_distance(o, d));
-    t_max = min(t_max, frame_depth_distance(pixel, block_depth(px, frame.grid_divisor)));
+    t_max = min(t_max, frame_depth_distance(pixel, frame_block_depth(host_depth, px, frame.grid_divisor)));
     var below = environment_ground_radiance(frame.ground_albedo, o);
     if frame.has_ground == 0u {
         below = environment_sky_radiance(vec3<f32>(0.0, -1.0, 0.0));

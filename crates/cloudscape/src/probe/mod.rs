@@ -65,6 +65,17 @@ pub enum ProbeFunction {
     /// `slab_scattering(SlabModel(lobes a, params b), cos theta c.x, tau_sun c.y, tau_back c.z)`:
     /// `SunSlab::scattering`.
     SunSlab = 22,
+    /// `march_sun_optical_depth(a.xyz, steps b.x, jitter b.y)`: `raymarch::light::sun_optical_depth`.
+    MarchSunOpticalDepth = 23,
+    /// `march_back_optical_depth(a.xyz, steps b.x, jitter b.y)`:
+    /// `raymarch::light::back_optical_depth`.
+    MarchBackOpticalDepth = 24,
+    /// `blend_merge(BlendSegment(a.x, a.y, a.z, b.xyz), BlendSegment(c.x, c.y, c.z, d.xyz))` as
+    /// (colour, far_m): `particles::blend::merge`.
+    BlendMerge = 25,
+    /// `sprite_level(colours a + k^2 b for k = 0..4, heights (c, d.x), h d.y)`:
+    /// `sprites::shading::level_at`.
+    SpriteLevel = 26,
 }
 
 /// The inputs of one evaluation.
@@ -77,6 +88,8 @@ pub struct ProbeInput {
     pub b: Vec4,
     /// Third argument vector.
     pub c: Vec4,
+    /// Fourth argument vector.
+    pub d: Vec4,
 }
 
 /// The probe pipeline, built against the shared groups.
@@ -158,5 +171,16 @@ impl Probe {
         }
         ctx.queue.submit([encoder.finish()]);
         readback::read_buffer::<Vec4>(ctx, &output)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout_check::assert_wgsl_layout;
+
+    #[test]
+    fn probe_inputs_match_their_wgsl_layout() {
+        assert_wgsl_layout!("probe", "ProbeInput", ProbeInput { a, b, c, d });
     }
 }

@@ -1,4 +1,4 @@
-#import hiheight frame environment tonemap phase slab
+#import hiheight frame environment tonemap phase slab march_light particle_blend sprite
 // Evaluates one WGSL function that has a CPU twin at given inputs, so tests can hold the GPU
 // against the specification (probe/mod.rs lists the functions and their twins).
 
@@ -6,6 +6,7 @@ struct ProbeInput {
     a: vec4<f32>,
     b: vec4<f32>,
     c: vec4<f32>,
+    d: vec4<f32>,
 }
 
 struct Probe {
@@ -16,7 +17,7 @@ struct Probe {
 @group(3) @binding(1) var<storage, read> probe_inputs: array<ProbeInput>;
 @group(3) @binding(2) var<storage, read_write> probe_outputs: array<vec4<f32>>;
 
-fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
+fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>) -> vec4<f32> {
     switch f {
         case 0u: { return vec4<f32>(field_extinction(a.xyz)); }
         case 1u: { return vec4<f32>(field_extinction_coarse(a.xyz)); }
@@ -41,6 +42,16 @@ fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
         case 20u: { return vec4<f32>(frame_two_stream_share_from_below(a.x, a.y)); }
         case 21u: { return vec4<f32>(phase_octaves(a, b.xyz, u32(c.z), c.x, c.y)); }
         case 22u: { return vec4<f32>(slab_scattering(SlabModel(a, b), c.x, c.y, c.z)); }
+        case 23u: { return vec4<f32>(march_sun_optical_depth(a.xyz, u32(b.x), b.y)); }
+        case 24u: { return vec4<f32>(march_back_optical_depth(a.xyz, u32(b.x), b.y)); }
+        case 25u: {
+            let merged = blend_merge(BlendSegment(a.x, a.y, a.z, b.xyz), BlendSegment(c.x, c.y, c.z, d.xyz));
+            return vec4<f32>(merged.colour, merged.far_m);
+        }
+        case 26u: {
+            let colors = array<vec4<f32>, 5>(a, a + b, a + 4.0 * b, a + 9.0 * b, a + 16.0 * b);
+            return sprite_level(colors, array<f32, 5>(c.x, c.y, c.z, c.w, d.x), d.y);
+        }
         default: { return vec4<f32>(-1.0); }
     }
 }
@@ -51,5 +62,5 @@ fn probe_functions(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let input = probe_inputs[id.x];
-    probe_outputs[id.x] = probe_eval(probe.function, input.a, input.b, input.c);
+    probe_outputs[id.x] = probe_eval(probe.function, input.a, input.b, input.c, input.d);
 }

@@ -2,6 +2,8 @@
 //! that writes, per output texel, the radiance the clouds scatter toward the eye, the transmittance
 //! through them and the cloud distance ([`crate::output`]), stopping at the host's depth buffer.
 
+pub mod light;
+
 use crate::field::FieldError;
 use crate::frame::{Shared, SharedSlots};
 use crate::gpu::GpuContext;

@@ -1,4 +1,4 @@
-#import hiheight frame environment phase slab
+#import hiheight frame environment phase slab march_light
 // Ray-marched clouds: per output texel, in-scattered radiance, transmittance and distance of the
 // cloud field along the view ray, up to the host's depth buffer (the cloud-output contract,
 // output/mod.rs). No haze: the compositor applies aerial perspective at the cloud distance.
@@ -49,34 +49,6 @@ struct MarchSum {
 
 // Rays stop once this little light gets through (VolumeCloud's threshold, peers.md).
 const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
-// Optical depth toward the sun from p, through the coarse (uneroded) density as Schneider 2015's
-// cheap light samples: `light_steps` segments whose lengths double, covering the way to the top of
-// the layers (MARCH_SUN_PATH_MIN_M..MARCH_SUN_PATH_MAX_M, raymarch::SUN_PATH_M) (VolumeCloud samples the sun path at 0.5, 1.5, 3, 6, 12
-// units with weights 1, 1, 2, 4, 8; peers.md).
-fn march_sun_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
-    let sun = environment_sun_direction();
-    var length_m = MARCH_SUN_PATH_MAX_M;
-    if field.layer_count > 0u {
-        length_m = clamp(field_below(p, sun, field.layer_top_m).y, MARCH_SUN_PATH_MIN_M, MARCH_SUN_PATH_MAX_M);
-    }
-    return field_optical_depth_coarse(p, sun, vec3<f32>(0.0, length_m, 2.0), march.light_steps, jitter);
-}
-
-// Optical depth away from the sun from p, through the coarse density, to where the path leaves the
-// layers (the bottom, or the top when the sun is below the horizon), within the sun path's bounds:
-// the far side of the slab model. `back_steps` doubling segments, as toward the sun.
-fn march_back_optical_depth(p: vec3<f32>, jitter: f32) -> f32 {
-    let away = -environment_sun_direction();
-    var length_m = MARCH_SUN_PATH_MAX_M;
-    if field.layer_count > 0u {
-        let below = field_below(p, away, field.layer_bottom_m);
-        let through_top = field_below(p, away, field.layer_top_m).y;
-        let to_bottom = select(through_top, below.x, below.x <= below.y && below.x > 0.0);
-        length_m = clamp(to_bottom, MARCH_SUN_PATH_MIN_M, MARCH_SUN_PATH_MAX_M);
-    }
-    return field_optical_depth_coarse(p, away, vec3<f32>(0.0, length_m, 2.0), march.back_steps, jitter);
-}
-
 // The sun's light scattered at p toward the eye along d, per unit sigma_s and unit irradiance, by
 // the scene's model of multiple scattering, with tau_sun the optical depth toward the sun.
 fn march_sun_scattering(p: vec3<f32>, d: vec3<f32>, tau_sun: f32, jitter: f32) -> f32 {
@@ -84,7 +56,7 @@ fn march_sun_scattering(p: vec3<f32>, d: vec3<f32>, tau_sun: f32, jitter: f32) -
     // Both models, chosen by select: lavapipe recompiles (and leaks) a shader that branches on a
     // uniform alone at every upload. The octave model marches no back samples (back_steps = 0).
     let slab = SlabModel(march.phase_lobes, march.slab_params);
-    let by_slab = slab_scattering(slab, cos_theta, tau_sun, march_back_optical_depth(p, jitter));
+    let by_slab = slab_scattering(slab, cos_theta, tau_sun, march_back_optical_depth(p, march.back_steps, jitter));
     let factors = vec3<f32>(march.octave_attenuation, march.octave_contribution, march.octave_eccentricity);
     let by_octaves = phase_octaves(march.phase_lobes, factors, march.octaves, cos_theta, tau_sun);
     return select(by_octaves, by_slab, march.lighting_model == 0u);
@@ -197,7 +169,7 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
             continue;
         }
         let column = march_column(p, field_altitude_m(p));
-        let tau_sun = march_sun_optical_depth(p, jitter);
+        let tau_sun = march_sun_optical_depth(p, march.light_steps, jitter);
         let sun = march_sun_scattering(p, d, tau_sun, jitter) * light.sun;
         let source = albedo * (sun + march_ambient(column, light));
         let step_transmittance = exp(-sigma_t * dt);
@@ -226,21 +198,6 @@ fn march_ray_offset(px: vec2<u32>) -> f32 {
     return fract(frame.ray_offset_strata + MARCH_BAYER_3X3[(px.x % 3u) * 3u + px.y % 3u] / 9.0);
 }
 
-// The farthest host depth over a block of the full-resolution depth buffer: a low-resolution ray
-// must not stop short of geometry that only part of its block has (Yusov 2014).
-fn march_block_depth(block: vec2<u32>, size: u32) -> f32 {
-    var depth = 1.0 - frame.depth_far_value; // the nearest value: any geometry is farther
-    let full = vec2<u32>(frame.viewport_px);
-    for (var y = 0u; y < size; y++) {
-        for (var x = 0u; x < size; x++) {
-            let texel = min(block * size + vec2<u32>(x, y), full - 1u);
-            depth = frame_farther_depth(depth, textureLoad(host_depth, vec2<i32>(texel), 0).x);
-        }
-    }
-    return depth;
-}
-
-
 // One sample of one ray per texel of the output grid (1/divisor of the frame's resolution), through
 // the sub-pixel of its block the frame's grid names. With several samples per pixel the pass is
 // dispatched once per sample and sums them in `march_sums`: llvmpipe caps the loop iterations of
@@ -261,7 +218,7 @@ fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     let pixel = vec2<f32>(full_px) + 0.5;
     let o = frame.camera_position_m;
     let d = frame_ray_direction(pixel);
-    let depth = march_block_depth(px, divisor);
+    let depth = frame_block_depth(host_depth, px, divisor);
     var t_max = min(frame.far_m, field_ground_distance(o, d, frame.has_ground == 1u));
     t_max = min(t_max, frame_depth_distance(pixel, depth));
     let spp = march.samples_per_pixel;

@@ -53,3 +53,18 @@ fn sprite_host_fade(depth: f32, texel: vec2<f32>, distance_m: f32, soft_m: f32) 
     let host_m = frame_depth_distance(pixel, depth);
     return clamp((host_m - distance_m) / soft_m, 0.0, 1.0);
 }
+
+// The colour at height fraction `h` of a cloud whose five levels have `colors` at `heights`,
+// interpolated linearly between them and held at the ends (shading::level_at, its CPU twin).
+fn sprite_level(colors: array<vec4<f32>, 5>, heights: array<f32, 5>, h: f32) -> vec4<f32> {
+    if h <= heights[0] {
+        return colors[0];
+    }
+    for (var i = 1u; i < 5u; i++) {
+        if h <= heights[i] {
+            let t = (h - heights[i - 1u]) / max(heights[i] - heights[i - 1u], 1e-6);
+            return mix(colors[i - 1u], colors[i], t);
+        }
+    }
+    return colors[4];
+}

@@ -64,21 +64,6 @@ struct Varying {
 // Sheet layout (sprites/textures.rs).
 const SHEET_TILES: f32 = 4.0;
 
-// The colour at height fraction h: shading::level_at.
-fn sprite_level(c: Cloud, h: f32) -> vec4<f32> {
-    let heights = array<f32, 5>(c.level_heights.x, c.level_heights.y, c.level_heights.z, c.level_heights.w, c.top_level_height);
-    if h <= heights[0] {
-        return c.colors[0];
-    }
-    for (var i = 1u; i < 5u; i++) {
-        if h <= heights[i] {
-            let t = (h - heights[i - 1u]) / max(heights[i] - heights[i - 1u], 1e-6);
-            return mix(c.colors[i - 1u], c.colors[i], t);
-        }
-    }
-    return c.colors[4];
-}
-
 // Where the sprite's centre is now: its wind frame moved by its layer's drift.
 fn sprite_centre(s: Sprite) -> vec3<f32> {
     if s.layer >= 4u {
@@ -135,7 +120,8 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     let far = 1.0 - smoothstep(view.fade_start_m, view.fade_end_m, horizontal);
 
     let c = clouds[s.cloud];
-    let level = sprite_level(c, clamp((p.y - c.bottom_y_m) / max(c.height_m, 1.0), 0.0, 1.0));
+    let heights = array<f32, 5>(c.level_heights.x, c.level_heights.y, c.level_heights.z, c.level_heights.w, c.top_level_height);
+    let level = sprite_level(c.colors, heights, clamp((p.y - c.bottom_y_m) / max(c.height_m, 1.0), 0.0, 1.0));
     let maxima = sprite_max_colours(p);
     let view_dir = normalize(p - view.eye_m);
     let phase = phase_eval(settings.phase_lobes, dot(view_dir, environment_sun_direction()));

@@ -228,3 +228,27 @@ pub fn sector_elevations(
     let margin = 0.02 * (hi - lo) + 1e-3;
     (lo - margin, hi + margin)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout_check::assert_wgsl_layout;
+
+    #[test]
+    fn the_view_uniform_matches_its_wgsl_layout() {
+        assert_wgsl_layout!(
+            "sprite_render",
+            "View",
+            ViewUniform {
+                clip_from_world,
+                eye_m,
+                host_depth_test,
+                forward,
+                lock_distance_m,
+                target_offset_ndc,
+                fade_start_m,
+                fade_end_m,
+            }
+        );
+    }
+}
