@@ -5,12 +5,12 @@
 //!
 //! `cargo run -p cloudscape --example host -- [OUT.png]`
 
-use cloudscape::frame::{DepthConvention, Frame, FrameSun, direction_from_angles_deg};
+use cloudscape::frame::{DepthConvention, Frame, FrameSun};
 use cloudscape::gpu::{GpuContext, read_texture, read_texture_rgba16f};
 use cloudscape::image::LdrImage;
 use cloudscape::post::Background;
 use cloudscape::renderer::{CloudRenderer, Reuse};
-use cloudscape::scene::SceneDocument;
+use cloudscape::scene::{SceneDocument, direction_from_angles_deg};
 use glam::{UVec2, Vec3};
 use wgpu::util::DeviceExt;
 

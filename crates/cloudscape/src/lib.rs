@@ -25,6 +25,7 @@ pub mod image;
 pub mod optics;
 pub mod output;
 pub mod particles;
+pub mod pass;
 pub mod post;
 pub mod probe;
 pub mod raymarch;

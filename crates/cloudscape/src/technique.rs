@@ -7,9 +7,10 @@
 
 use crate::environment::Environment;
 use crate::field::{CloudField, FieldError};
-use crate::frame::{Frame, Shared};
+use crate::frame::Frame;
 use crate::gpu::{GpuContext, PassTimer};
 use crate::output::{CloudOutput, SampleGrid};
+use crate::pass::Shared;
 use crate::scene::Scene;
 use glam::UVec2;
 use std::path::Path;

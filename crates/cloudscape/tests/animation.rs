@@ -65,7 +65,7 @@ fn flythrough() -> Scene {
 /// The camera's position and unit view direction at `time_s`.
 fn eye_and_view(scene: &Scene, time_s: f32) -> (Vec3, Vec3) {
     let camera = scene_at(scene, time_s).camera;
-    let view = cloudscape::frame::direction_from_angles_deg(camera.pitch_deg, camera.yaw_deg);
+    let view = cloudscape::scene::direction_from_angles_deg(camera.pitch_deg, camera.yaw_deg);
     (Vec3::from_array(camera.position_m), view)
 }
 

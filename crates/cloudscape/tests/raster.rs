@@ -44,7 +44,6 @@ fn splats_blend_premultiplied_and_respect_a_read_only_depth_buffer() {
         &ctx,
         &RasterDescriptor {
             label: "splats",
-            source: SPLAT_WGSL,
             entries: ("vs", "fs"),
             targets: &[Some(wgpu::ColorTargetState {
                 format,
@@ -57,6 +56,7 @@ fn splats_blend_premultiplied_and_respect_a_read_only_depth_buffer() {
             }),
             topology: wgpu::PrimitiveTopology::TriangleStrip,
         },
+        SPLAT_WGSL,
         &[],
     );
     let mut encoder = ctx.device.create_command_encoder(&Default::default());

@@ -1,54 +1,55 @@
 //! Every WGSL program the crate builds parses and validates with naga, with no GPU; every `.wgsl`
-//! file in the source tree is a registered module that some program reaches; and every program
-//! binds the shared groups at their fixed slots.
+//! file in the source tree is a module that some program reaches; the shared groups sit at their
+//! fixed slots, and a library module binds only in its own group.
 
-use cloudscape::shader::{self, ENVIRONMENT_GROUP, FIELD_GROUP, FRAME_GROUP, MODULES, PROGRAMS};
-use std::collections::HashSet;
-use std::path::Path;
-
-fn parse(name: &str) -> naga::Module {
-    let source = shader::program(name);
-    let module = naga::front::wgsl::parse_str(&source)
-        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
-    naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::empty(),
-    )
-    .validate(&module)
-    .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
-    module
-}
+use cloudscape::environment::ENVIRONMENT_WGSL;
+use cloudscape::field::gpu::FIELD_WGSL;
+use cloudscape::frame::FRAME_WGSL;
+use cloudscape::renderer::PROGRAMS;
+use cloudscape::shader::{ENVIRONMENT_GROUP, FIELD_GROUP, FRAME_GROUP, Program, WgslModule};
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
 
 #[test]
 fn every_program_validates() {
-    for name in PROGRAMS {
-        let module = parse(name);
-        assert!(!module.entry_points.is_empty(), "{name} has no entry point");
+    for root in PROGRAMS {
+        let (module, _) = Program::new(root)
+            .validate()
+            .unwrap_or_else(|e| panic!("{}: {e}", root.name));
+        assert!(
+            !module.entry_points.is_empty(),
+            "{} has no entry point",
+            root.name
+        );
     }
 }
 
 #[test]
-fn shared_groups_sit_at_the_same_slot_in_every_program() {
-    let slots = [
-        ("field", FIELD_GROUP),
-        ("frame", FRAME_GROUP),
-        ("environment", ENVIRONMENT_GROUP),
+fn each_module_binds_only_its_own_group() {
+    let own: [(&WgslModule, u32); 3] = [
+        (&FIELD_WGSL, FIELD_GROUP),
+        (&FRAME_WGSL, FRAME_GROUP),
+        (&ENVIRONMENT_WGSL, ENVIRONMENT_GROUP),
     ];
-    for name in PROGRAMS {
-        let module = parse(name);
-        for (_, var) in module.global_variables.iter() {
-            let (Some(var_name), Some(binding)) = (&var.name, &var.binding) else {
-                continue;
+    for root in PROGRAMS {
+        for module in Program::new(root).modules() {
+            let expected = match own.iter().find(|(m, _)| std::ptr::eq(*m, *module)) {
+                Some((_, group)) => vec![*group],
+                None if std::ptr::eq(*module, *root) => module.groups(),
+                None => vec![],
             };
-            if let Some((_, group)) = slots.iter().find(|(n, _)| n == var_name) {
-                assert_eq!(binding.group, *group, "{name}: {var_name}");
-                assert_eq!(binding.binding, 0, "{name}: {var_name}");
-            }
+            assert_eq!(
+                module.groups(),
+                expected,
+                "{} (in {}) binds outside its own group",
+                module.name,
+                root.name
+            );
         }
     }
 }
 
-fn wgsl_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+fn wgsl_files(dir: &Path, out: &mut BTreeSet<PathBuf>) {
     for entry in std::fs::read_dir(dir)
         .expect("source directory is readable")
         .flatten()
@@ -57,44 +58,30 @@ fn wgsl_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
         if path.is_dir() {
             wgsl_files(&path, out);
         } else if path.extension().is_some_and(|e| e == "wgsl") {
-            out.push(path);
+            out.insert(path.canonicalize().expect("a real file"));
         }
     }
 }
 
 #[test]
 fn every_wgsl_file_is_a_module_some_program_reaches() {
-    let mut files = Vec::new();
-    wgsl_files(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("src"),
-        &mut files,
-    );
-    assert_eq!(files.len(), MODULES.len(), "{files:?}");
-    let mut reached = HashSet::new();
-    for name in PROGRAMS {
-        let text = shader::program(name);
-        for m in MODULES {
-            let body: String = m
-                .source
-                .lines()
-                .filter(|l| !l.starts_with("#import "))
-                .map(|l| format!("{l}\n"))
-                .collect();
-            if text.contains(&body) {
-                reached.insert(m.name);
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = BTreeSet::new();
+    wgsl_files(&manifest.join("src"), &mut files);
+    let workspace = manifest.join("../..");
+    let mut reached = BTreeSet::new();
+    for root in PROGRAMS {
+        for module in Program::new(root).modules() {
+            let path = workspace.join(module.path());
+            if path.extension().is_some_and(|e| e == "wgsl") {
+                let text = std::fs::read_to_string(&path).expect("the module's file exists");
+                assert_eq!(text, module.source, "{} is its file", module.name);
+                reached.insert(path.canonicalize().expect("a real file"));
             }
         }
     }
-    for file in files {
-        let text = std::fs::read_to_string(&file).expect("readable");
-        let module = MODULES
-            .iter()
-            .find(|m| m.source == text)
-            .unwrap_or_else(|| panic!("{} is not a registered module", file.display()));
-        assert!(
-            reached.contains(module.name),
-            "no program uses {}",
-            module.name
-        );
-    }
+    assert_eq!(
+        files, reached,
+        "every .wgsl file, and only those, is reached"
+    );
 }

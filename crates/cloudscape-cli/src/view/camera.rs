@@ -1,9 +1,8 @@
 //! The viewer's camera: a fly camera and an orbit around a point, in the scene's conventions
 //! (metres, `y` up, `x` east, `z` south; yaw clockwise from north, pitch above the horizon; see
-//! `cloudscape::frame::direction_from_angles_deg`). Pure maths: no window, no GPU.
+//! `cloudscape::scene::direction_from_angles_deg`). Pure maths: no window, no GPU.
 
-use cloudscape::frame::direction_from_angles_deg;
-use cloudscape::scene::Camera;
+use cloudscape::scene::{Camera, direction_from_angles_deg};
 use glam::{Vec2, Vec3};
 
 /// Slowest fly speed: walking, m/s.

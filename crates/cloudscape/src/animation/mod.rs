@@ -14,16 +14,14 @@
 mod camera;
 #[cfg(feature = "gif")]
 mod preview;
-mod solar;
 mod spline;
 mod sun;
 
 pub use camera::{Aim, CameraPose, camera_at, unwrap_yaw_deg};
 #[cfg(feature = "gif")]
 pub use preview::{GifPreview, PreviewError, preview_size};
-pub use solar::{declination_rad, solar_direction, solar_position};
 pub use spline::{SplineValue, catmull_rom, velocity_at_key};
-pub use sun::{SunAngles, key_direction, sun_at};
+pub use sun::sun_at;
 
 use crate::scene::{Animation, CoverageKey, Scene};
 

@@ -2,36 +2,17 @@
 
 use glam::Vec3;
 
-use super::solar::solar_direction;
 use super::spline::catmull_rom;
-use crate::frame::direction_from_angles_deg;
-use crate::scene::{Sun, SunKey, TimeOfDay};
-
-/// The sun's place on the sky.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SunAngles {
-    /// Elevation above the horizon, degrees, -90..90.
-    pub elevation_deg: f32,
-    /// Azimuth, degrees clockwise from north, 0..360.
-    pub azimuth_deg: f32,
-}
-
-impl SunAngles {
-    /// Sets `sun`'s elevation and azimuth to these (its irradiance and colour are left as they are).
-    pub fn apply_to(&self, sun: &mut Sun) {
-        sun.elevation_deg = self.elevation_deg;
-        sun.azimuth_deg = self.azimuth_deg;
-    }
-}
+use crate::scene::{SunAngles, SunKey, TimeOfDay, angles_of, key_direction, solar_direction};
 
 /// Largest step of solar time between the samples that trace the sun's course between two
 /// solar-time keyframes, hours (3.75 degrees of hour angle).
 const SOLAR_SAMPLE_STEP_H: f32 = 0.25;
 
 /// The sun at `time_s` on `path` (keyframe times strictly increasing); `None` for an empty path.
-/// Keyframes given by solar time are placed by [`solar_position`] on the latitude and day of `day`
-/// (a keyframe that cannot be placed, by solar time without `day`, is skipped; validation rejects
-/// it).
+/// Keyframes given by solar time are placed by [`crate::scene::solar_position`] on the latitude
+/// and day of `day` (a keyframe that cannot be placed, by solar time without `day`, is skipped;
+/// validation rejects it).
 ///
 /// The keyframes' unit directions follow a [`catmull_rom`] spline, projected back onto the sphere
 /// by normalising: a smooth path on the sky (C1 wherever the spline is not zero, which neighbours
@@ -43,19 +24,6 @@ pub fn sun_at(path: &[SunKey], day: Option<&TimeOfDay>, time_s: f32) -> Option<S
     let keys = traced_path(path, day);
     let direction = catmull_rom(&keys, time_s)?.normalize_or(keys[0].1);
     Some(angles_of(direction))
-}
-
-/// The direction toward the sun a keyframe gives: its angles, or its solar time on the latitude
-/// and day of `day`; `None` when it has neither (or solar time but no `day`).
-pub fn key_direction(key: &SunKey, day: Option<&TimeOfDay>) -> Option<Vec3> {
-    if let (Some(elevation_deg), Some(azimuth_deg)) = (key.sun_elevation_deg, key.sun_azimuth_deg) {
-        return Some(direction_from_angles_deg(elevation_deg, azimuth_deg));
-    }
-    let time = TimeOfDay {
-        solar_time_h: key.solar_time_h?,
-        ..day?.clone()
-    };
-    Some(solar_direction(&time))
 }
 
 /// `(time_s, direction)` of every keyframe, with samples of the sun's course between consecutive
@@ -84,23 +52,11 @@ fn traced_path(path: &[SunKey], day: Option<&TimeOfDay>) -> Vec<(f32, Vec3)> {
     traced
 }
 
-/// Elevation and azimuth of the unit vector `direction`; the inverse of
-/// [`direction_from_angles_deg`] (azimuth 0 straight up or down).
-pub(super) fn angles_of(direction: Vec3) -> SunAngles {
-    SunAngles {
-        elevation_deg: direction.y.clamp(-1.0, 1.0).asin().to_degrees(),
-        azimuth_deg: direction
-            .x
-            .atan2(-direction.z)
-            .to_degrees()
-            .rem_euclid(360.0),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::spline::tests::one_sided_velocities;
     use super::*;
+    use crate::scene::direction_from_angles_deg;
 
     fn key(time_s: f32, sun_elevation_deg: f32, sun_azimuth_deg: f32) -> SunKey {
         SunKey::at_angles(time_s, sun_elevation_deg, sun_azimuth_deg)
@@ -179,7 +135,7 @@ mod tests {
         for step in 0..=24 {
             let time_s = step as f32 * 0.5;
             let angles = sun_at(&path, Some(&day), time_s).unwrap();
-            let truth = crate::animation::solar_position(&TimeOfDay {
+            let truth = crate::scene::solar_position(&TimeOfDay {
                 solar_time_h: 6.0 + time_s,
                 ..day.clone()
             });

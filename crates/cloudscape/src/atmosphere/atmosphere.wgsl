@@ -1,4 +1,3 @@
-#import constants phase
 // The air over a spherical planet (atmosphere/medium.rs) and the parameterisations of Hillaire
 // 2020's look-up tables (atmosphere/luts.rs): pure functions of the `Air` uniform, each the twin
 // of the Rust function named beside it. The tables themselves are bound by environment.wgsl.

@@ -6,11 +6,14 @@
 //! Positions here are relative to the planet centre ("atmosphere space"); [`Air::position_of`]
 //! maps a world point there.
 
-use crate::environment::KOSCHMIEDER_CONTRAST;
 use crate::optics::phase::draine;
 use crate::scene::{PlanetShape, Scene};
 use glam::Vec3;
 use std::f32::consts::PI;
+
+/// `-ln(0.02)`: visibility is the distance at which haze leaves 2 % contrast, so the haze extinction
+/// is 3.912 / visibility (Koschmieder 1924).
+pub const KOSCHMIEDER_CONTRAST: f32 = 3.912;
 
 /// Earth's ground radius, metres (Bruneton 2017).
 pub const EARTH_RADIUS_M: f32 = 6_360_000.0;

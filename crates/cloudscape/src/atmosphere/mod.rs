@@ -8,12 +8,13 @@
 //! tables the GPU builds (`atmosphere.wgsl`, [`gpu::AtmosphereTables`]) and the path tracer lights
 //! with it; tests hold each GPU table to it.
 
-pub mod gpu;
 pub mod luts;
 pub mod medium;
 pub mod table;
+mod wgsl;
 
 pub use medium::Air;
+pub use wgsl::ATMOSPHERE_WGSL;
 
 use glam::Vec3;
 use luts::{IRRADIANCE_SIZE, LocalRay, SkyTables, sun_table_uv};

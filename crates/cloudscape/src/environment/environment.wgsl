@@ -1,4 +1,3 @@
-#import constants atmosphere
 // The environment interface (environment/mod.rs): sun, sky, haze and the clouds' shadows, bound at
 // group 2. Techniques, the compositor and hosts light only through these functions. With
 // sky_model 1 they read the atmosphere's tables (Hillaire 2020); otherwise the analytic gradient

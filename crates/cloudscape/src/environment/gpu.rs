@@ -394,6 +394,26 @@ impl EnvironmentGpu {
     }
 }
 
+/// The environment on the GPU (`environment.wgsl`, group [`crate::shader::ENVIRONMENT_GROUP`]): sun, sky, aerial perspective and the clouds' shadow, for every technique and for a host's own shaders ([`crate::shader::Program::host`]).
+pub static ENVIRONMENT_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "environment",
+    "environment.wgsl",
+    [
+        &crate::shader::MATH_WGSL,
+        &crate::atmosphere::ATMOSPHERE_WGSL
+    ]
+);
+
+impl crate::pass::SharedGroup for EnvironmentGpu {
+    fn layout(&self) -> &wgpu::BindGroupLayout {
+        EnvironmentGpu::layout(self)
+    }
+
+    fn bind_group(&self) -> &wgpu::BindGroup {
+        EnvironmentGpu::bind_group(self)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -402,7 +422,7 @@ mod tests {
     #[test]
     fn environment_uniform_matches_its_wgsl_layout() {
         assert_wgsl_layout!(
-            "probe",
+            &crate::probe::PROBE_WGSL,
             "Environment",
             EnvironmentUniform {
                 sun_direction,
@@ -420,7 +440,7 @@ mod tests {
             }
         );
         assert_wgsl_layout!(
-            "probe",
+            &crate::probe::PROBE_WGSL,
             "Air",
             AirUniform {
                 rayleigh_scattering_per_m,
@@ -436,7 +456,7 @@ mod tests {
             }
         );
         assert_wgsl_layout!(
-            "probe",
+            &crate::probe::PROBE_WGSL,
             "CloudShadow",
             CloudShadowUniform {
                 centre_m,

@@ -21,17 +21,22 @@
 //! fills the tables each frame. [`Environment`] and [`ViewedEnvironment`] are the CPU twins: the
 //! path tracer lights with them, and probe tests hold the GPU functions against them.
 
+mod atmosphere_passes;
 mod gpu;
 mod passes;
+mod shadow_pass;
 mod table_pass;
 
+pub use atmosphere_passes::{ATMOSPHERE_AERIAL_WGSL, ATMOSPHERE_LUTS_WGSL, ATMOSPHERE_MARCH_WGSL};
 pub use gpu::{
-    AirUniform, CloudShadowUniform, EnvironmentGpu, EnvironmentTable, EnvironmentUniform,
-    TABLE_FORMAT,
+    AirUniform, CloudShadowUniform, ENVIRONMENT_WGSL, EnvironmentGpu, EnvironmentTable,
+    EnvironmentUniform, TABLE_FORMAT,
 };
 pub use passes::EnvironmentPasses;
+pub use shadow_pass::CLOUD_SHADOW_WGSL;
 pub use table_pass::TablePass;
 
+use crate::atmosphere::medium::KOSCHMIEDER_CONTRAST;
 use crate::atmosphere::{Air, Atmosphere, SkyView};
 use crate::frame::FrameSun;
 use crate::scene::Scene;
@@ -43,10 +48,6 @@ use std::sync::Arc;
 /// Linear limb-darkening coefficient of the sun's disc in the visible: `I(mu) / I(1) = 1 - u (1 -
 /// mu)`, u about 0.6 at 550 nm (Pierce & Slaughter 1977, "Solar limb darkening", Solar Physics 51).
 pub const SUN_LIMB_DARKENING: f32 = 0.6;
-
-/// `-ln(0.02)`: visibility is the distance at which haze leaves 2 % contrast, so the haze extinction
-/// is 3.912 / visibility (Koschmieder 1924).
-pub const KOSCHMIEDER_CONTRAST: f32 = 3.912;
 
 /// The sky's radiance by direction.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,11 +1,11 @@
 //! The environment's passes of a frame: the clouds' shadow map, then (with the atmosphere) the
 //! sky's tables, before any technique reads them.
 
-use super::{Environment, SkyModel};
-use crate::atmosphere::gpu::{AtmospherePasses, FRAME_PASS_NAMES, TABLE_PASS_NAMES};
-use crate::frame::Shared;
+use super::atmosphere_passes::{AtmospherePasses, FRAME_PASS_NAMES, TABLE_PASS_NAMES};
+use super::shadow_pass::{CloudShadowPass, SHADOW_PASS_NAME};
+use super::{Environment, EnvironmentGpu, SkyModel};
 use crate::gpu::{GpuContext, PassTimer};
-use crate::shadow::gpu::{CloudShadowPass, SHADOW_PASS_NAME};
+use crate::pass::Shared;
 
 /// The shadow-map pass and the atmosphere's table passes, made once.
 pub struct EnvironmentPasses {
@@ -34,23 +34,24 @@ impl EnvironmentPasses {
         names
     }
 
-    /// Records the frame's passes for `env` (the uniform already written): the shadow map when
+    /// Records the frame's passes for `env` (the uniform already written) into the environment's
+    /// tables: the shadow map when
     /// `build_shadow` (else the one built before is read), and the sky's tables.
     pub fn encode(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        shared: &Shared,
+        groups: (&Shared, &EnvironmentGpu),
         (env, build_shadow): (&Environment, bool),
         mut timer: Option<&mut PassTimer>,
     ) {
         if build_shadow {
             self.shadow
-                .encode(ctx, encoder, shared, timer.as_deref_mut());
+                .encode(ctx, encoder, groups, timer.as_deref_mut());
         }
         if env.sky_model == SkyModel::Atmosphere {
             self.atmosphere
-                .encode(ctx, encoder, shared, &env.air, timer);
+                .encode(ctx, encoder, groups, &env.air, timer);
         }
     }
 }

@@ -1,4 +1,3 @@
-#import constants
 // The cloud field on the GPU: the twin of field/mod.rs and field/layer.rs, line for line.
 // Everything it binds lives in bind group 0; techniques put their own resources in group 1+.
 

@@ -6,8 +6,7 @@ use super::hiheight::HiHeight;
 use super::{CloudField, MAX_LAYERS, MAX_VOLUMES, NoiseKind};
 use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{
-    UNIFORM, bind_group, bind_group_layout, compute_pipeline, float_texture, storage_binding,
-    storage_buffer,
+    UNIFORM, bind_group, bind_group_layout, float_texture, storage_binding, storage_buffer,
 };
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
@@ -434,22 +433,18 @@ fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture
         "noise texels",
         (row_pitch * dims.y * dims.z * 4) as u64,
     );
-    let layout = bind_group_layout(
-        device,
-        "noise generator",
-        &[UNIFORM, storage_binding(false)],
-    );
-    let pipeline = compute_pipeline(
+    let generator = crate::pass::ComputePass::standalone(
         ctx,
         "noise generator",
-        &crate::shader::program("noise_gen"),
-        "generate_noise",
-        &[None, None, None, Some(&layout)],
+        &NOISE_GEN_WGSL,
+        &["generate_noise"],
     );
-    let group = bind_group(
-        device,
-        &layout,
-        &[uniform.as_entire_binding(), buffer.as_entire_binding()],
+    let group = generator.group.bind(
+        ctx,
+        &[
+            ("noise_gen", uniform.as_entire_binding()),
+            ("noise_texels", buffer.as_entire_binding()),
+        ],
     );
     let label = format!("{kind:?} noise");
     let dimension = if kind == NoiseKind::Curl {
@@ -467,7 +462,7 @@ fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture
     let mut encoder = device.create_command_encoder(&Default::default());
     {
         let mut pass = encoder.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
+        pass.set_pipeline(generator.main());
         pass.set_bind_group(crate::shader::PASS_GROUP, &group, &[]);
         pass.dispatch_workgroups(dims.x.div_ceil(4), dims.y.div_ceil(4), dims.z.div_ceil(4));
     }
@@ -491,6 +486,42 @@ fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture
     texture
 }
 
+/// The cloud field on the GPU (`field.wgsl`, group [`crate::shader::FIELD_GROUP`]): the twin of [`super::CloudField`].
+pub static FIELD_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("field", "field.wgsl", [], field_constants);
+
+/// Empty-space skipping over the field's hi-height levels (`hiheight.wgsl`).
+pub static HIHEIGHT_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("hiheight", "hiheight.wgsl", [&FIELD_WGSL]);
+
+/// The pass that bakes the field's noise textures (`noise_gen.wgsl`).
+pub static NOISE_GEN_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("noise_gen", "noise_gen.wgsl", [&super::noise::NOISE_WGSL]);
+
+/// The field's constants as WGSL: layer and volume limits, the hi-height levels, the type profile.
+fn field_constants() -> String {
+    use super::profile::{TYPE_BLEND_HALF_WIDTH, TYPE_GRADIENTS};
+    use crate::shader::WgslConst::{F32, U32, Vec4Array};
+    crate::shader::wgsl_consts([
+        ("MAX_LAYERS", U32(super::MAX_LAYERS as u32)),
+        ("GOLDEN_RATIO_CONJUGATE", F32(super::GOLDEN_RATIO_CONJUGATE)),
+        ("MAX_VOLUMES", U32(super::MAX_VOLUMES as u32)),
+        ("MAX_HIHEIGHT_LEVELS", U32(MAX_HIHEIGHT_LEVELS as u32)),
+        ("TYPE_GRADIENTS", Vec4Array(&TYPE_GRADIENTS)),
+        ("TYPE_BLEND_HALF_WIDTH", F32(TYPE_BLEND_HALF_WIDTH)),
+    ])
+}
+
+impl crate::pass::SharedGroup for FieldGpu {
+    fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    fn bind_group(&self) -> &wgpu::BindGroup {
+        &self.bind_group
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -499,7 +530,7 @@ mod tests {
     #[test]
     fn field_uniforms_match_their_wgsl_layouts() {
         assert_wgsl_layout!(
-            "probe",
+            &crate::probe::PROBE_WGSL,
             "Field",
             FieldUniform {
                 planet_radius_m,
@@ -522,7 +553,7 @@ mod tests {
             }
         );
         assert_wgsl_layout!(
-            "probe",
+            &crate::probe::PROBE_WGSL,
             "FieldLayer",
             LayerUniform {
                 bottom_m,
@@ -538,7 +569,7 @@ mod tests {
             }
         );
         assert_wgsl_layout!(
-            "probe",
+            &crate::probe::PROBE_WGSL,
             "FieldVolume",
             VolumeUniform {
                 min_m,
@@ -550,7 +581,7 @@ mod tests {
             }
         );
         assert_wgsl_layout!(
-            "noise_gen",
+            &crate::field::gpu::NOISE_GEN_WGSL,
             "NoiseGenParams",
             NoiseGenParams {
                 kind,

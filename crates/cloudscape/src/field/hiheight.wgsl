@@ -1,4 +1,3 @@
-#import field
 // Hi-height traversal (field/hiheight.rs builds the pyramid): how far along a ray the layers are
 // provably empty, stepping up and down the max pyramid as hi-Z screen-space reflections do.
 

@@ -21,6 +21,8 @@ pub use texture::Texture8;
 pub use voxel::VoxelGrid;
 pub use weather::Weather;
 
+pub use crate::scene::MAX_LAYERS;
+
 use crate::scene::{NoiseSettings, PlanetShape, Scene};
 use glam::{Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -30,8 +32,6 @@ use std::sync::{Arc, Mutex, OnceLock, Weak};
 /// segments of a light path sample decorrelated offsets.
 pub const GOLDEN_RATIO_CONJUGATE: f32 = 0.618034;
 
-/// Most cloud layers one field holds (the GPU uniform's array size).
-pub const MAX_LAYERS: usize = 4;
 /// Most voxel grids one field holds.
 pub const MAX_VOLUMES: usize = 4;
 

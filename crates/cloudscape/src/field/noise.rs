@@ -254,6 +254,10 @@ impl NoiseKind {
     }
 }
 
+/// The hash and value noise the field and the particles share (`noise.wgsl`).
+pub static NOISE_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("noise", "noise.wgsl", []);
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,4 +1,3 @@
-#import noise
 // Fills a storage buffer with one noise texture's 8-bit RGBA texels (kind 0 base, 1 detail,
 // 2 curl), rows padded to `row_pitch_texels`, ready for copy_buffer_to_texture. Writing through a
 // buffer rather than a 3D storage texture keeps the GL backend working (wgpu-and-crates.md).

@@ -6,19 +6,7 @@
 
 use super::noise::remap;
 use crate::scene::CloudTypeMix;
-
-/// Density-height gradients of the anchor types as (rise start, rise end, fall start, fall end),
-/// fractions of the layer thickness. Stratus and stratocumulus are VolumeCloud's fallback gradients
-/// (peers.md, from yangrc1234/VolumeCloud). Cumulus rises as fast as VolumeCloud's but thins from 20 %
-/// of the layer to its top instead of holding full density to 75 %: thresholded by coverage, a long
-/// linear fall gives domed tops where a plateau gives flat-topped slabs (tuned by eye on the default
-/// scene). Cumulonimbus fills the layer like Schneider 2015's towering type.
-pub const TYPE_GRADIENTS: [[f32; 4]; 4] = [
-    [0.0, 0.07, 0.08, 0.15],
-    [0.0, 0.2, 0.42, 0.6],
-    [0.0, 0.1, 0.2, 1.0],
-    [0.0, 0.05, 0.9, 1.0],
-];
+pub use crate::scene::TYPE_GRADIENTS;
 
 /// Half-width of the blend between two types of a mix, on the weather map's type channel (0..1).
 pub const TYPE_BLEND_HALF_WIDTH: f32 = 0.05;

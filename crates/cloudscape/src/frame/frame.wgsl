@@ -1,4 +1,3 @@
-#import constants noise
 // One frame's camera, ground and sampling grid: the twin of frame/mod.rs (FrameUniform member for
 // member). Bound once, at group 1, in every program that uses it.
 

@@ -60,6 +60,20 @@ impl FrameUniform {
 /// frame.
 pub type FrameGpu = UniformGroup<FrameUniform>;
 
+/// The frame on the GPU (`frame.wgsl`, group [`crate::shader::FRAME_GROUP`]).
+pub static FRAME_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("frame", "frame.wgsl", [&crate::field::noise::NOISE_WGSL]);
+
+impl crate::pass::SharedGroup for FrameGpu {
+    fn layout(&self) -> &wgpu::BindGroupLayout {
+        FrameGpu::layout(self)
+    }
+
+    fn bind_group(&self) -> &wgpu::BindGroup {
+        FrameGpu::bind_group(self)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -68,7 +82,7 @@ mod tests {
     #[test]
     fn frame_uniform_matches_its_wgsl_layout() {
         assert_wgsl_layout!(
-            "probe",
+            &crate::probe::PROBE_WGSL,
             "Frame",
             FrameUniform {
                 clip_from_world,

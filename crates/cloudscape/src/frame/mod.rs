@@ -9,23 +9,14 @@
 
 mod depth;
 mod gpu;
-mod shared;
 
 pub use depth::DepthConvention;
-pub use gpu::{FrameGpu, FrameUniform};
-pub use shared::{Shared, SharedSlots};
+pub use gpu::{FRAME_WGSL, FrameGpu, FrameUniform};
 
 use crate::optics::PhaseLobes;
 use crate::output::SampleGrid;
-use crate::scene::{Camera, Scene, Sun};
+use crate::scene::{Camera, Scene, Sun, direction_from_angles_deg};
 use glam::{Mat4, UVec2, Vec3};
-
-/// Unit vector toward elevation `el` and azimuth `az` (degrees; azimuth clockwise from north, with
-/// x east, y up, z south): `(sin az cos el, sin el, -cos az cos el)`.
-pub fn direction_from_angles_deg(elevation_deg: f32, azimuth_deg: f32) -> Vec3 {
-    let (el, az) = (elevation_deg.to_radians(), azimuth_deg.to_radians());
-    Vec3::new(az.sin() * el.cos(), el.sin(), -az.cos() * el.cos())
-}
 
 /// Normalised device depth of the point `camera_ray` and `frame_ray_direction` unproject to find a
 /// pixel's ray: between the near and far planes in every [`DepthConvention`].
@@ -203,19 +194,6 @@ impl Frame {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn angles_follow_the_compass() {
-        assert!(
-            direction_from_angles_deg(0.0, 0.0).abs_diff_eq(Vec3::NEG_Z, 1e-6),
-            "north is -z"
-        );
-        assert!(
-            direction_from_angles_deg(0.0, 90.0).abs_diff_eq(Vec3::X, 1e-6),
-            "east is +x"
-        );
-        assert!(direction_from_angles_deg(90.0, 0.0).abs_diff_eq(Vec3::Y, 1e-6));
-    }
 
     #[test]
     fn centre_ray_looks_where_the_camera_looks() {

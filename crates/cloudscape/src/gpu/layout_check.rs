@@ -1,17 +1,22 @@
 //! Test support: a Rust struct shared with WGSL has the size and member offsets that naga gives the
 //! WGSL struct of the same name, so moving, adding or retyping a field on one side fails a test.
 
-/// Asserts that the WGSL struct `wgsl_name` of program `root` ([`crate::shader::program`]) has
-/// size `size` and exactly the members `fields` (name, byte offset), in order.
-pub fn assert_layout(root: &str, wgsl_name: &str, size: usize, fields: &[(&str, usize)]) {
-    let source = crate::shader::program(root);
-    let module = naga::front::wgsl::parse_str(&source)
-        .unwrap_or_else(|e| panic!("{root}: {}", e.emit_to_string(&source)));
+/// Asserts that the WGSL struct `wgsl_name` of the program of `root` ([`crate::shader::Program`])
+/// has size `size` and exactly the members `fields` (name, byte offset), in order.
+pub fn assert_layout(
+    root: &'static crate::shader::WgslModule,
+    wgsl_name: &str,
+    size: usize,
+    fields: &[(&str, usize)],
+) {
+    let (module, _) = crate::shader::Program::new(root)
+        .validate()
+        .unwrap_or_else(|e| panic!("{e}"));
     let (_, ty) = module
         .types
         .iter()
         .find(|(_, t)| t.name.as_deref() == Some(wgsl_name))
-        .unwrap_or_else(|| panic!("{root} has no struct {wgsl_name}"));
+        .unwrap_or_else(|| panic!("{} has no struct {wgsl_name}", root.name));
     let naga::TypeInner::Struct { members, span } = &ty.inner else {
         panic!("{wgsl_name} is not a struct");
     };

@@ -170,7 +170,7 @@ pub fn bind_group(
 /// program binds nothing at.
 pub type GroupLayouts<'a> = [Option<&'a wgpu::BindGroupLayout>];
 
-/// The shader module of a whole WGSL program ([`crate::shader::program`]).
+/// The shader module of a whole WGSL program ([`crate::shader::Program`]).
 pub fn shader_module(ctx: &GpuContext, label: &str, source: &str) -> wgpu::ShaderModule {
     ctx.device
         .create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -224,8 +224,6 @@ pub struct DepthTest {
 pub struct RasterDescriptor<'a> {
     /// Pipeline label.
     pub label: &'a str,
-    /// The whole WGSL program.
-    pub source: &'a str,
     /// Vertex and fragment entry points.
     pub entries: (&'a str, &'a str),
     /// Colour targets, e.g. premultiplied-alpha blending into a cloud output.
@@ -240,9 +238,10 @@ pub struct RasterDescriptor<'a> {
 pub fn render_pipeline(
     ctx: &GpuContext,
     raster: &RasterDescriptor,
+    source: &str,
     layouts: &GroupLayouts,
 ) -> wgpu::RenderPipeline {
-    let module = shader_module(ctx, raster.label, raster.source);
+    let module = shader_module(ctx, raster.label, source);
     let depth_stencil = raster.depth.map(|d| wgpu::DepthStencilState {
         format: d.format,
         depth_write_enabled: Some(false),
@@ -327,47 +326,6 @@ pub fn clear_depth(encoder: &mut wgpu::CommandEncoder, view: &wgpu::TextureView,
     });
 }
 
-/// Bind groups made once and remade only when the views they bind change (a resized target): no
-/// bind group is created per frame. Holds two, so a pass that alternates between ping-pong
-/// targets (temporal history) keeps both.
-#[derive(Default)]
-pub struct BindGroupCache {
-    entries: Vec<(Vec<wgpu::TextureView>, wgpu::BindGroup)>,
-}
-
-/// Bind groups a [`BindGroupCache`] keeps.
-const CACHED_GROUPS: usize = 2;
-
-impl BindGroupCache {
-    /// The bind group for `views`, made by `make` when no kept group binds them.
-    pub fn get(
-        &mut self,
-        views: &[&wgpu::TextureView],
-        make: impl FnOnce() -> wgpu::BindGroup,
-    ) -> &wgpu::BindGroup {
-        let same = |kept: &[wgpu::TextureView]| {
-            kept.len() == views.len() && kept.iter().zip(views).all(|(a, b)| a == *b)
-        };
-        let index = match self.entries.iter().position(|(kept, _)| same(kept)) {
-            Some(index) => index,
-            None => {
-                if self.entries.len() == CACHED_GROUPS {
-                    self.entries.remove(0);
-                }
-                let kept = views.iter().map(|v| (*v).clone()).collect();
-                self.entries.push((kept, make()));
-                self.entries.len() - 1
-            }
-        };
-        &self.entries[index].1
-    }
-
-    /// Forgets the groups (a buffer they bind was replaced).
-    pub fn clear(&mut self) {
-        self.entries.clear();
-    }
-}
-
 /// Records one compute pass over `size` pixels in 8x8 workgroups.
 pub fn dispatch_2d(
     encoder: &mut wgpu::CommandEncoder,
@@ -402,40 +360,5 @@ pub fn dispatch_2d_repeated(
     }
     for _ in 0..times {
         pass.dispatch_workgroups(size.x.div_ceil(8), size.y.div_ceil(8), 1);
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn cached_bind_groups_are_made_once_per_set_of_views() {
-        let ctx = GpuContext::for_tests();
-        let format = wgpu::TextureFormat::Rgba16Float;
-        let usage = wgpu::TextureUsages::TEXTURE_BINDING;
-        let view = |label| {
-            texture_2d(&ctx, label, glam::UVec2::ONE, format, usage)
-                .create_view(&Default::default())
-        };
-        let (a, b, c) = (view("a"), view("b"), view("c"));
-        let layout = bind_group_layout(
-            &ctx.device,
-            "cache test",
-            &[float_texture(wgpu::TextureViewDimension::D2)],
-        );
-        let mut made = 0;
-        let mut cache = BindGroupCache::default();
-        for v in [&a, &b, &a, &b, &a, &c, &c] {
-            cache.get(&[v], || {
-                made += 1;
-                bind_group(
-                    &ctx.device,
-                    &layout,
-                    &[wgpu::BindingResource::TextureView(v)],
-                )
-            });
-        }
-        assert_eq!(made, 3, "ping-pong between a and b makes each once; c once");
     }
 }

@@ -16,8 +16,6 @@
 use glam::Vec3;
 use std::f64::consts::PI;
 
-use crate::scene::{PhaseFunction, PhaseModel};
-
 /// Smallest droplet diameter, in micrometres, of the approximate-Mie fit (Jendersie & d'Eon 2023).
 pub const MIE_FIT_MIN_DIAMETER_UM: f32 = 5.0;
 /// Largest droplet diameter, in micrometres, of the approximate-Mie fit (Jendersie & d'Eon 2023).
@@ -74,17 +72,6 @@ impl PhaseLobes {
             g_draine: (-2.20679 / (d + 3.91029) - 0.428934).exp(),
             alpha: (3.62489 - 8.29288 / (d + 5.52825)).exp(),
             w_draine: (-0.599085 / (d - 0.641583) - 0.665888).exp(),
-        }
-    }
-
-    /// The lobes of a scene's phase-function settings.
-    pub fn from_scene(p: &PhaseFunction) -> Self {
-        match p.model {
-            PhaseModel::Mie => Self::approximate_mie(p.droplet_diameter_um),
-            PhaseModel::Hg => Self::henyey_greenstein(p.g),
-            PhaseModel::DualHg => {
-                Self::dual_henyey_greenstein(p.g_forward, p.g_back, p.forward_weight)
-            }
         }
     }
 
@@ -326,6 +313,10 @@ fn rotate_about(axis: Vec3, cos_theta: f32, sin_theta: f32, phi_rad: f32) -> Vec
     let (sin_phi, cos_phi) = phi_rad.sin_cos();
     (tangent * cos_phi + bitangent * sin_phi) * sin_theta + axis * cos_theta
 }
+
+/// The phase functions on the GPU (`phase.wgsl`), twins of this module's.
+pub static PHASE_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("phase", "phase.wgsl", [&crate::shader::MATH_WGSL]);
 
 #[cfg(test)]
 #[path = "phase_tests.rs"]

@@ -1,4 +1,3 @@
-#import constants
 // Phase functions of cloud droplets: the GPU twin of optics/phase.rs (same formulas, same names).
 //
 // Sign convention: cos_theta = dot(direction light travels before scattering, direction after),

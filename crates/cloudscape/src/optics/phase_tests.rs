@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::optics::test_support::{Pcg32, chi_square_p_value};
+use crate::scene::{PhaseFunction, PhaseModel};
 use glam::DVec3;
 
 /// Bands of scattering angle, with edges `theta_i = pi (i / n)^3`: narrow near the forward peak.

@@ -206,6 +206,22 @@ pub fn second_legendre_moment(lobes: &PhaseLobes) -> f32 {
     (1.0 - lobes.w_draine) * hg + lobes.w_draine * draine
 }
 
+/// The two-stream slab on the GPU (`slab.wgsl`), the twin of this module.
+pub static SLAB_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "slab",
+    "slab.wgsl",
+    [&crate::shader::MATH_WGSL, &super::phase::PHASE_WGSL],
+    slab_constants
+);
+
+/// The slab's constants as WGSL.
+fn slab_constants() -> String {
+    crate::shader::wgsl_consts([(
+        "SLAB_MAX_TWO_STREAM_ALBEDO",
+        crate::shader::WgslConst::F32(MAX_TWO_STREAM_ALBEDO),
+    )])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,4 +1,3 @@
-#import constants phase
 // The sun's light inside a cloud by the delta-Eddington solution of a slab along the sun: the GPU
 // twin of optics/slab.rs (SunSlab), which derives and cites every formula. Functions only.
 

@@ -169,6 +169,10 @@ impl PixelBlend {
     }
 }
 
+/// Particle blending on the GPU (`particle_blend.wgsl`), the twin of this module.
+pub static PARTICLE_BLEND_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("particle_blend", "particle_blend.wgsl", []);
+
 #[cfg(test)]
 mod tests {
     use super::*;

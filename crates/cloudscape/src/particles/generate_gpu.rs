@@ -6,12 +6,9 @@
 use bytemuck::{Pod, Zeroable};
 
 use super::generate::{Generation, ListedCell, Particle};
-use crate::frame::{Shared, SharedSlots};
 use crate::gpu::GpuContext;
-use crate::gpu::pipeline::{
-    UNIFORM, bind_group, bind_group_layout, compute_pipeline, storage_binding, storage_buffer,
-    uniform_buffer,
-};
+use crate::gpu::pipeline::{storage_buffer, uniform_buffer};
+use crate::pass::{ComputePass, Shared};
 
 /// Most particles the GPU holds: the render pass packs a particle's index into 20 bits.
 pub const MAX_PARTICLES: u32 = 1 << 20;
@@ -86,11 +83,7 @@ impl GenerationCounts {
 
 /// The generation passes and their buffers, sized for one grid.
 pub struct ParticleGenerator {
-    slots: SharedSlots,
-    list: wgpu::ComputePipeline,
-    size_cells: wgpu::ComputePipeline,
-    generate: wgpu::ComputePipeline,
-    size_particles: wgpu::ComputePipeline,
+    pass: ComputePass,
     uniform: wgpu::Buffer,
     /// The passes' bind group: binding the dispatch sizes, and binding a stand-in for them.
     groups: [wgpu::BindGroup; 2],
@@ -107,21 +100,18 @@ pub struct ParticleGenerator {
 impl ParticleGenerator {
     /// Builds the passes and buffers for the grid of `g`.
     pub fn new(ctx: &GpuContext, shared: &Shared, g: &Generation) -> ParticleGenerator {
-        let layout = bind_group_layout(
-            &ctx.device,
+        let pass = ComputePass::new(
+            ctx,
+            shared,
             "particle generation",
+            &PARTICLE_GENERATE_WGSL,
             &[
-                UNIFORM,
-                storage_binding(false),
-                storage_binding(false),
-                storage_binding(false),
-                storage_binding(false),
+                "list_cells",
+                "size_dispatches",
+                "generate_particles",
+                "size_particle_dispatch",
             ],
         );
-        let slots = SharedSlots::of("particle_generate");
-        let source = crate::shader::program("particle_generate");
-        let layouts = shared.layouts(slots, &layout);
-        let pipeline = |entry: &str| compute_pipeline(ctx, entry, &source, entry, &layouts);
         let capacity = capacity(g);
         let uniform = uniform_buffer(
             ctx,
@@ -151,25 +141,20 @@ impl ParticleGenerator {
         // generation pass binds a stand-in instead.
         let stand_in = storage_buffer(ctx, "particle dispatches stand-in", 24);
         let group_with = |args: &wgpu::Buffer| {
-            bind_group(
-                &ctx.device,
-                &layout,
+            pass.group.bind(
+                ctx,
                 &[
-                    uniform.as_entire_binding(),
-                    cells.as_entire_binding(),
-                    counts.as_entire_binding(),
-                    args.as_entire_binding(),
-                    particles.as_entire_binding(),
+                    ("generation", uniform.as_entire_binding()),
+                    ("listed_cells", cells.as_entire_binding()),
+                    ("counts", counts.as_entire_binding()),
+                    ("dispatches", args.as_entire_binding()),
+                    ("particles", particles.as_entire_binding()),
                 ],
             )
         };
         let groups = [group_with(&dispatches), group_with(&stand_in)];
         ParticleGenerator {
-            slots,
-            list: pipeline("list_cells"),
-            size_cells: pipeline("size_dispatches"),
-            generate: pipeline("generate_particles"),
-            size_particles: pipeline("size_particle_dispatch"),
+            pass,
             uniform,
             groups,
             counts,
@@ -206,16 +191,17 @@ impl ParticleGenerator {
             timestamp_writes: timestamps,
         });
         let [sizing, generating] = &self.groups;
-        set_groups(&mut pass, &shared.bind_groups(self.slots, sizing));
-        pass.set_pipeline(&self.list);
+        let (slots, entry) = (self.pass.slots, |name| self.pass.pipeline(name));
+        set_groups(&mut pass, &shared.bind_groups(slots, sizing));
+        pass.set_pipeline(entry("list_cells"));
         pass.dispatch_workgroups(self.column_count.div_ceil(WORKGROUP), 1, 1);
-        pass.set_pipeline(&self.size_cells);
+        pass.set_pipeline(entry("size_dispatches"));
         pass.dispatch_workgroups(1, 1, 1);
-        set_groups(&mut pass, &shared.bind_groups(self.slots, generating));
-        pass.set_pipeline(&self.generate);
+        set_groups(&mut pass, &shared.bind_groups(slots, generating));
+        pass.set_pipeline(entry("generate_particles"));
         pass.dispatch_workgroups_indirect(&self.dispatches, 0);
-        set_groups(&mut pass, &shared.bind_groups(self.slots, sizing));
-        pass.set_pipeline(&self.size_particles);
+        set_groups(&mut pass, &shared.bind_groups(slots, sizing));
+        pass.set_pipeline(entry("size_particle_dispatch"));
         pass.dispatch_workgroups(1, 1, 1);
     }
 
@@ -252,6 +238,20 @@ pub fn set_groups(pass: &mut wgpu::ComputePass, groups: &[Option<&wgpu::BindGrou
     }
 }
 
+/// The pass that generates the particles from the field (`particle_generate.wgsl`).
+pub static PARTICLE_GENERATE_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "particle_generate",
+    "particle_generate.wgsl",
+    [
+        &crate::shader::MATH_WGSL,
+        &crate::field::gpu::FIELD_WGSL,
+        &crate::field::noise::NOISE_WGSL,
+        &crate::frame::FRAME_WGSL,
+        &crate::environment::ENVIRONMENT_WGSL,
+        &super::gpu::PARTICLE_WGSL
+    ]
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -260,7 +260,7 @@ mod tests {
     #[test]
     fn generation_structs_match_their_wgsl_layouts() {
         assert_wgsl_layout!(
-            "particle_generate",
+            &crate::particles::generate_gpu::PARTICLE_GENERATE_WGSL,
             "Generation",
             GenerationUniform {
                 sigma_max_per_m,
@@ -277,7 +277,7 @@ mod tests {
             }
         );
         assert_wgsl_layout!(
-            "particle_generate",
+            &crate::particles::generate_gpu::PARTICLE_GENERATE_WGSL,
             "Particle",
             Particle {
                 centre_m,
@@ -293,12 +293,12 @@ mod tests {
             }
         );
         assert_wgsl_layout!(
-            "particle_generate",
+            &crate::particles::generate_gpu::PARTICLE_GENERATE_WGSL,
             "ListedCell",
             crate::particles::generate::ListedCell { column, layers }
         );
         assert_wgsl_layout!(
-            "particle_render",
+            &crate::particles::render::PARTICLE_RENDER_WGSL,
             "ParticleShape",
             crate::particles::density::ParticleShape {
                 base_cells,

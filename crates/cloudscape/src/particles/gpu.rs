@@ -13,10 +13,8 @@ use super::optical_depth::{
     ChordProfile, OpticalDepthLayout, OpticalDepthTable, STEPS_PER_DIAMETER,
 };
 use crate::gpu::GpuContext;
-use crate::gpu::pipeline::{
-    UNIFORM, bind_group, bind_group_layout, compute_pipeline, float_texture, storage_binding,
-    storage_buffer,
-};
+use crate::gpu::pipeline::storage_buffer;
+use crate::pass::ComputePass;
 
 /// Format of the optical-depth texture: filterable 16-bit floats on every backend.
 pub const OPTICAL_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
@@ -57,42 +55,23 @@ pub struct OpticalDepthLut {
 
 /// The bake's pipelines, made once and reused for every rebake.
 pub struct OpticalDepthBaker {
-    group_layout: wgpu::BindGroupLayout,
-    density: wgpu::ComputePipeline,
-    chords: wgpu::ComputePipeline,
-    probe: wgpu::ComputePipeline,
+    pass: ComputePass,
 }
 
 impl OpticalDepthBaker {
     /// Compiles the bake's programs.
     pub fn new(ctx: &GpuContext) -> OpticalDepthBaker {
-        let group_layout = bind_group_layout(
-            &ctx.device,
-            "particle bake",
-            &[
-                UNIFORM,
-                storage_binding(false),
-                storage_binding(false),
-                float_texture(wgpu::TextureViewDimension::D3),
-                wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                storage_binding(true),
-            ],
-        );
-        let source = crate::shader::program("particle_bake");
-        let pipeline = |entry: &str| {
-            compute_pipeline(
-                ctx,
-                entry,
-                &source,
-                entry,
-                &[None, None, None, Some(&group_layout)],
-            )
-        };
         OpticalDepthBaker {
-            density: pipeline("bake_particle_noise"),
-            chords: pipeline("bake_optical_depth"),
-            probe: pipeline("probe_optical_depth"),
-            group_layout,
+            pass: ComputePass::standalone(
+                ctx,
+                "particle bake",
+                &PARTICLE_BAKE_WGSL,
+                &[
+                    "bake_particle_noise",
+                    "bake_optical_depth",
+                    "probe_optical_depth",
+                ],
+            ),
         }
     }
 
@@ -120,9 +99,9 @@ impl OpticalDepthBaker {
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             pass.set_bind_group(crate::shader::PASS_GROUP, &group, &[]);
-            pass.set_pipeline(&self.density);
+            pass.set_pipeline(self.pass.pipeline("bake_particle_noise"));
             pass.dispatch_workgroups(n.div_ceil(4), n.div_ceil(4), n.div_ceil(4));
-            pass.set_pipeline(&self.chords);
+            pass.set_pipeline(self.pass.pipeline("bake_optical_depth"));
             pass.dispatch_workgroups(dims.x.div_ceil(2).div_ceil(8), dims.y.div_ceil(8), dims.z);
         }
         encoder.copy_buffer_to_texture(
@@ -175,7 +154,7 @@ impl OpticalDepthBaker {
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             pass.set_bind_group(crate::shader::PASS_GROUP, &group, &[]);
-            pass.set_pipeline(&self.probe);
+            pass.set_pipeline(self.pass.pipeline("probe_optical_depth"));
             pass.dispatch_workgroups(count.div_ceil(64), 1, 1);
         }
         ctx.queue.submit([encoder.finish()]);
@@ -199,16 +178,21 @@ impl OpticalDepthBaker {
                 usage: wgpu::BufferUsages::UNIFORM,
             });
         let view = lut.texture.create_view(&Default::default());
-        bind_group(
-            &ctx.device,
-            &self.group_layout,
+        self.pass.group.bind(
+            ctx,
             &[
-                uniform.as_entire_binding(),
-                voxels.as_entire_binding(),
-                words.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&view),
-                wgpu::BindingResource::Sampler(&lut.sampler),
-                lut.chord_buffer.as_entire_binding(),
+                ("bake", uniform.as_entire_binding()),
+                ("noise_voxels", voxels.as_entire_binding()),
+                ("optical_depth_words", words.as_entire_binding()),
+                (
+                    "optical_depth_lut",
+                    wgpu::BindingResource::TextureView(&view),
+                ),
+                (
+                    "optical_depth_sampler",
+                    wgpu::BindingResource::Sampler(&lut.sampler),
+                ),
+                ("chord_mean_density", lut.chord_buffer.as_entire_binding()),
             ],
         )
     }
@@ -300,6 +284,31 @@ fn create_lut(
     }
 }
 
+/// The reference particle on the GPU (`particle.wgsl`).
+pub static PARTICLE_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "particle",
+    "particle.wgsl",
+    [&crate::shader::MATH_WGSL, &crate::field::noise::NOISE_WGSL]
+);
+
+/// The optical-depth table's look-up (`particle_lookup.wgsl`).
+pub static PARTICLE_LOOKUP_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "particle_lookup",
+    "particle_lookup.wgsl",
+    [&crate::shader::MATH_WGSL, &PARTICLE_WGSL]
+);
+
+/// The passes that bake the optical-depth table (`particle_bake.wgsl`).
+pub static PARTICLE_BAKE_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "particle_bake",
+    "particle_bake.wgsl",
+    [
+        &crate::shader::MATH_WGSL,
+        &PARTICLE_WGSL,
+        &PARTICLE_LOOKUP_WGSL
+    ]
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -308,7 +317,7 @@ mod tests {
     #[test]
     fn the_bake_uniform_matches_its_wgsl_layout() {
         assert_wgsl_layout!(
-            "particle_bake",
+            &crate::particles::gpu::PARTICLE_BAKE_WGSL,
             "ParticleBake",
             ParticleBake {
                 table_dims,

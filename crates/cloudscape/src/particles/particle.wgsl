@@ -1,4 +1,3 @@
-#import noise
 // The reference particle and its optical-depth look-up: the GPU twins of particles/density.rs and
 // particles/optical_depth.rs (see there for the sources and the parameterisation).
 

@@ -1,4 +1,3 @@
-#import particle particle_lookup
 // Bakes the optical-depth table of the reference particle (particles/gpu.rs): the particle's
 // noise into a voxel buffer, then the optical-mass ratio of every chord through it, packed two 16-bit
 // floats per word in rows padded for copy_buffer_to_texture. A buffer rather than a storage
@@ -21,7 +20,10 @@ struct ParticleBake {
 @group(3) @binding(0) var<uniform> bake: ParticleBake;
 @group(3) @binding(1) var<storage, read_write> noise_voxels: array<f32>;
 @group(3) @binding(2) var<storage, read_write> optical_depth_words: array<u32>;
-// Bindings 3-5 (the baked table, its sampler and the chord masses): particle_lookup.wgsl.
+// The optical-depth table that particle_lookup.wgsl reads.
+@group(3) @binding(3) var optical_depth_lut: texture_3d<f32>;
+@group(3) @binding(4) var optical_depth_sampler: sampler;
+@group(3) @binding(5) var<storage, read> chord_mean_density: array<f32>;
 
 @compute @workgroup_size(4, 4, 4)
 fn bake_particle_noise(@builtin(global_invocation_id) id: vec3<u32>) {

@@ -1,4 +1,3 @@
-#import field noise frame environment particle
 // Particle generation on the GPU: the twin of particles/grid.rs and particles/generate.rs, line for
 // line (see there for the sources). Three entry points, dispatched in order each frame:
 // `list_cells` (one invocation per grid column: the seed's append buffer of non-empty cells),

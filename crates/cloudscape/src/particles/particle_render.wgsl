@@ -1,4 +1,3 @@
-#import frame environment phase particle particle_lookup particle_blend
 // Particle rendering in compute (particles/render.rs): the particles of particle_generate.wgsl
 // binned into screen tiles (`bin_particles`, one invocation per particle), then one workgroup per
 // tile (`render_tiles`) that sorts the tile's list by distance and blends, per pixel, the segment of
@@ -28,7 +27,13 @@ struct Render {
 @group(3) @binding(1) var<storage, read> particles: array<Particle>;
 // particle_generate.wgsl's counts: [1] particles made.
 @group(3) @binding(2) var<storage, read> counts: array<u32, 4>;
-// Bindings 3-7: the tables (particle_lookup.wgsl).
+// The optical-depth table that particle_lookup.wgsl reads.
+@group(3) @binding(3) var optical_depth_lut: texture_3d<f32>;
+@group(3) @binding(4) var optical_depth_sampler: sampler;
+@group(3) @binding(5) var<storage, read> chord_mean_density: array<f32>;
+// Single (r, without the phase function) and multiple (g) scattering (ScatteringLut).
+@group(3) @binding(6) var scattering_lut: texture_3d<f32>;
+@group(3) @binding(7) var scattering_sampler: sampler;
 @group(3) @binding(8) var<storage, read_write> tile_counts: array<atomic<u32>>;
 // Per tile, `tile_capacity` sort keys: quantised log distance << 20 | particle index.
 @group(3) @binding(9) var<storage, read_write> tile_entries: array<u32>;
@@ -383,4 +388,31 @@ fn render_tiles(
     atomicAdd(&render_stats[1], 1u);
     textureStore(cloud_out, vec2<i32>(px), vec4<f32>(blend.radiance, blend.transmittance));
     textureStore(cloud_distance_out, vec2<i32>(px), vec4<f32>(distance_m, 0.0, 0.0, 0.0));
+}
+
+// (S, M) for light leaving the unit sphere at `point` along `out` (toward the eye), lit from
+// `to_light`: ScatteringTables::lookup (texture coordinates as texture_coordinates there).
+fn particle_scattering(point: vec3<f32>, out: vec3<f32>, to_light: vec3<f32>) -> vec2<f32> {
+    let n = normalize(point);
+    let cos_entry = clamp(dot(n, to_light), -1.0, 1.0);
+    let away = n * cos_entry - to_light;
+    var tangent = vec3<f32>(0.0);
+    if dot(away, away) > 1e-12 {
+        tangent = normalize(away);
+    } else {
+        tangent = particle_any_orthonormal(n);
+    }
+    let bitangent = cross(n, tangent);
+    let zenith = acos(clamp(dot(out, n), 0.0, 1.0));
+    let azimuth = atan2(abs(dot(out, bitangent)), dot(out, tangent));
+    let uvw = vec3<f32>(azimuth / PI, zenith / (0.5 * PI), acos(cos_entry) / PI);
+    return textureSampleLevel(scattering_lut, scattering_sampler, uvw, 0.0).xy;
+}
+
+// A unit vector orthogonal to unit `n`: glam's Vec3::any_orthonormal_vector (Duff et al. 2017).
+fn particle_any_orthonormal(n: vec3<f32>) -> vec3<f32> {
+    let sign = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    return vec3<f32>(b, sign + n.y * n.y * a, -n.y);
 }

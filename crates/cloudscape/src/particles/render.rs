@@ -16,16 +16,11 @@ use super::generate_gpu::{GenerationCounts, MAX_PARTICLES, ParticleGenerator, se
 use super::store::TableStore;
 use super::tables_gpu::ParticleTables;
 use crate::field::FieldError;
-use crate::frame::{Shared, SharedSlots};
 use crate::gpu::late_readback::LateReadback;
-use crate::gpu::pipeline::{
-    BindGroupCache, UNFILTERABLE_TEXTURE_2D, UNIFORM, bind_group, bind_group_layout,
-    compute_pipeline, float_texture, storage_binding, storage_buffer, storage_texture_2d,
-    uniform_buffer,
-};
+use crate::gpu::pipeline::{storage_buffer, uniform_buffer};
 use crate::gpu::{GpuContext, PassTimer};
 use crate::optics::PhaseLobes;
-use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
+use crate::pass::{BindGroupCache, ComputePass, Shared};
 use crate::scene::{PlanetShape, Scene};
 use crate::technique::{Draws, FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 
@@ -111,10 +106,7 @@ const STATS_BYTES: u64 = 16;
 
 /// The particle technique.
 pub struct ParticleRenderer {
-    slots: SharedSlots,
-    layout: wgpu::BindGroupLayout,
-    bin: wgpu::ComputePipeline,
-    render: wgpu::ComputePipeline,
+    pass: ComputePass,
     uniform: wgpu::Buffer,
     settings: RenderUniform,
     stats: wgpu::Buffer,
@@ -137,36 +129,14 @@ impl ParticleRenderer {
     /// Builds the passes against the shared groups' layouts; the tables are loaded by
     /// [`Technique::configure`], the particle buffers made by the first [`Technique::encode`].
     pub fn new(ctx: &GpuContext, shared: &Shared) -> ParticleRenderer {
-        let read_only = storage_binding(true);
-        let layout = bind_group_layout(
-            &ctx.device,
-            "particle render",
-            &[
-                UNIFORM,
-                read_only,
-                read_only,
-                float_texture(wgpu::TextureViewDimension::D3),
-                wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                read_only,
-                float_texture(wgpu::TextureViewDimension::D3),
-                wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                storage_binding(false),
-                storage_binding(false),
-                UNFILTERABLE_TEXTURE_2D,
-                storage_texture_2d(CLOUD_FORMAT),
-                storage_texture_2d(CLOUD_DISTANCE_FORMAT),
-                storage_binding(false),
-            ],
-        );
-        let slots = SharedSlots::of("particle_render");
-        let source = crate::shader::program("particle_render");
-        let layouts = shared.layouts(slots, &layout);
-        let pipeline = |entry: &str| compute_pipeline(ctx, entry, &source, entry, &layouts);
         ParticleRenderer {
-            slots,
-            bin: pipeline("bin_particles"),
-            render: pipeline("render_tiles"),
-            layout,
+            pass: ComputePass::new(
+                ctx,
+                shared,
+                "particle render",
+                &PARTICLE_RENDER_WGSL,
+                &["bin_particles", "render_tiles"],
+            ),
             uniform: uniform_buffer(ctx, "particle render", size_of::<RenderUniform>() as u64),
             settings: RenderUniform::zeroed(),
             stats: storage_buffer(ctx, "particle render stats", STATS_BYTES),
@@ -250,31 +220,31 @@ impl ParticleRenderer {
             self.generator.as_ref().expect("made by the frame's setup"),
             self.lists.as_ref().expect("made by the frame's setup"),
         );
-        let (layout, uniform, stats) = (&self.layout, &self.uniform, &self.stats);
+        let (pass, uniform, stats) = (&self.pass, &self.uniform, &self.stats);
         let views = [targets.host_depth, &output.radiance, &output.distance];
         self.group
             .get(&views, || {
                 let od = &tables.optical_depth;
                 let od_view = od.texture.create_view(&Default::default());
                 let sc_view = tables.scattering.texture.create_view(&Default::default());
-                bind_group(
-                    &ctx.device,
-                    layout,
+                use wgpu::BindingResource::{Sampler, TextureView};
+                pass.group.bind(
+                    ctx,
                     &[
-                        uniform.as_entire_binding(),
-                        generator.particles.as_entire_binding(),
-                        generator.counts.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(&od_view),
-                        wgpu::BindingResource::Sampler(&od.sampler),
-                        od.chord_buffer.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(&sc_view),
-                        wgpu::BindingResource::Sampler(&tables.scattering.sampler),
-                        lists.counts.as_entire_binding(),
-                        lists.entries.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(targets.host_depth),
-                        wgpu::BindingResource::TextureView(&output.radiance),
-                        wgpu::BindingResource::TextureView(&output.distance),
-                        stats.as_entire_binding(),
+                        ("render", uniform.as_entire_binding()),
+                        ("particles", generator.particles.as_entire_binding()),
+                        ("counts", generator.counts.as_entire_binding()),
+                        ("optical_depth_lut", TextureView(&od_view)),
+                        ("optical_depth_sampler", Sampler(&od.sampler)),
+                        ("chord_mean_density", od.chord_buffer.as_entire_binding()),
+                        ("scattering_lut", TextureView(&sc_view)),
+                        ("scattering_sampler", Sampler(&tables.scattering.sampler)),
+                        ("tile_counts", lists.counts.as_entire_binding()),
+                        ("tile_entries", lists.entries.as_entire_binding()),
+                        ("host_depth", TextureView(targets.host_depth)),
+                        ("cloud_out", TextureView(&output.radiance)),
+                        ("cloud_distance_out", TextureView(&output.distance)),
+                        ("render_stats", stats.as_entire_binding()),
                     ],
                 )
             })
@@ -312,8 +282,8 @@ impl ParticleRenderer {
             label: Some(PASS_NAMES[1]),
             timestamp_writes: writes,
         });
-        set_groups(&mut pass, &shared.bind_groups(self.slots, group));
-        pass.set_pipeline(&self.bin);
+        set_groups(&mut pass, &shared.bind_groups(self.pass.slots, group));
+        pass.set_pipeline(self.pass.pipeline("bin_particles"));
         pass.dispatch_workgroups_indirect(&generator.dispatches, 12);
     }
 }
@@ -408,8 +378,8 @@ impl Technique for ParticleRenderer {
             label: Some(PASS_NAMES[2]),
             timestamp_writes: writes,
         });
-        set_groups(&mut pass, &shared.bind_groups(self.slots, &group));
-        pass.set_pipeline(&self.render);
+        set_groups(&mut pass, &shared.bind_groups(self.pass.slots, &group));
+        pass.set_pipeline(self.pass.pipeline("render_tiles"));
         pass.dispatch_workgroups(tiles_x, rows, 1);
     }
 
@@ -430,6 +400,21 @@ impl Technique for ParticleRenderer {
     }
 }
 
+/// The particles' render pass (`particle_render.wgsl`).
+pub static PARTICLE_RENDER_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "particle_render",
+    "particle_render.wgsl",
+    [
+        &crate::shader::MATH_WGSL,
+        &crate::frame::FRAME_WGSL,
+        &crate::environment::ENVIRONMENT_WGSL,
+        &crate::optics::phase::PHASE_WGSL,
+        &super::gpu::PARTICLE_WGSL,
+        &super::gpu::PARTICLE_LOOKUP_WGSL,
+        &super::blend::PARTICLE_BLEND_WGSL
+    ]
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -438,7 +423,7 @@ mod tests {
     #[test]
     fn the_render_uniform_matches_its_wgsl_layout() {
         assert_wgsl_layout!(
-            "particle_render",
+            &crate::particles::render::PARTICLE_RENDER_WGSL,
             "Render",
             RenderUniform {
                 grid_size,

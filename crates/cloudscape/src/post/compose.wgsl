@@ -1,4 +1,3 @@
-#import field frame environment
 // Composes the cloud output over what lies behind it: the host's geometry where its depth buffer
 // holds some, else the sky, the sun's disc and the ground in the clouds' shadows. Aerial
 // perspective is applied here, once: to the background at its distance and to the clouds at their

@@ -1,4 +1,3 @@
-#import tonemap
 // HDR radiance to display: exposure, tone mapping (tonemap.wgsl) and sRGB encoding.
 
 struct Display {

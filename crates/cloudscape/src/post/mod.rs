@@ -6,13 +6,10 @@
 pub mod tonemap;
 pub mod upsample;
 
-use crate::frame::{Shared, SharedSlots};
-use crate::gpu::pipeline::{
-    BindGroupCache, UNFILTERABLE_TEXTURE_2D, UNIFORM, bind_group, bind_group_layout,
-    compute_pipeline, dispatch_2d, float_texture, storage_texture_2d, uniform_buffer,
-};
+use crate::gpu::pipeline::{dispatch_2d, uniform_buffer};
 use crate::gpu::{GpuContext, PassTimer};
 use crate::output::CloudOutput;
+use crate::pass::{BindGroupCache, ComputePass, Shared};
 use crate::scene::Tonemap;
 use bytemuck::{Pod, Zeroable};
 use glam::UVec2;
@@ -33,38 +30,16 @@ pub struct Background<'a> {
 
 /// Composes a full-resolution cloud output over the background: `background * a + hazed rgb`.
 pub struct Compositor {
-    slots: SharedSlots,
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    pass: ComputePass,
     group: BindGroupCache,
 }
 
 impl Compositor {
     /// Builds the pass against the shared groups' layouts.
     pub fn new(ctx: &GpuContext, shared: &Shared) -> Compositor {
-        let d2 = wgpu::TextureViewDimension::D2;
-        let layout = bind_group_layout(
-            &ctx.device,
-            "compose",
-            &[
-                float_texture(d2),
-                UNFILTERABLE_TEXTURE_2D,
-                UNFILTERABLE_TEXTURE_2D,
-                UNFILTERABLE_TEXTURE_2D,
-                storage_texture_2d(HDR_FORMAT),
-            ],
-        );
-        let pipeline = compute_pipeline(
-            ctx,
-            "compose",
-            &crate::shader::program("compose"),
-            "compose_clouds_over_background",
-            &shared.layouts(SharedSlots::of("compose"), &layout),
-        );
+        let entry = "compose_clouds_over_background";
         Compositor {
-            slots: SharedSlots::of("compose"),
-            pipeline,
-            layout,
+            pass: ComputePass::new(ctx, shared, "compose", &COMPOSE_WGSL, &[entry]),
             group: BindGroupCache::default(),
         }
     }
@@ -86,17 +61,25 @@ impl Compositor {
             background.depth,
             hdr,
         ];
-        let layout = &self.layout;
+        let pass = &self.pass;
         let group = self.group.get(&views, || {
+            let names = [
+                "compose_clouds",
+                "compose_cloud_distance",
+                "compose_host_color",
+                "compose_host_depth",
+                "compose_out",
+            ];
             let resources = views.map(wgpu::BindingResource::TextureView);
-            bind_group(&ctx.device, layout, &resources)
+            pass.group
+                .bind(ctx, &names.into_iter().zip(resources).collect::<Vec<_>>())
         });
         let writes = timer.and_then(|t| t.compute_pass_writes("compose"));
         dispatch_2d(
             encoder,
             "compose",
-            &self.pipeline,
-            &shared.bind_groups(self.slots, group),
+            pass.main(),
+            &shared.bind_groups(pass.slots, group),
             clouds.size,
             writes,
         );
@@ -113,8 +96,7 @@ struct DisplayUniform {
 
 /// Exposure, tone mapping and sRGB encoding into a [`DISPLAY_FORMAT`] texture.
 pub struct Display {
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    pass: ComputePass,
     uniform: wgpu::Buffer,
     group: BindGroupCache,
 }
@@ -122,25 +104,8 @@ pub struct Display {
 impl Display {
     /// Builds the pass.
     pub fn new(ctx: &GpuContext) -> Display {
-        let layout = bind_group_layout(
-            &ctx.device,
-            "display",
-            &[
-                UNIFORM,
-                float_texture(wgpu::TextureViewDimension::D2),
-                storage_texture_2d(DISPLAY_FORMAT),
-            ],
-        );
-        let pipeline = compute_pipeline(
-            ctx,
-            "display",
-            &crate::shader::program("display"),
-            "display_hdr_image",
-            &[None, None, None, Some(&layout)],
-        );
         Display {
-            pipeline,
-            layout,
+            pass: ComputePass::standalone(ctx, "display", &DISPLAY_WGSL, &["display_hdr_image"]),
             uniform: uniform_buffer(ctx, "display", size_of::<DisplayUniform>() as u64),
             group: BindGroupCache::default(),
         }
@@ -161,15 +126,15 @@ impl Display {
         };
         ctx.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-        let (layout, buffer) = (&self.layout, &self.uniform);
+        let (pass, buffer) = (&self.pass, &self.uniform);
         let group = self.group.get(&[hdr, out], || {
-            bind_group(
-                &ctx.device,
-                layout,
+            use wgpu::BindingResource::TextureView;
+            pass.group.bind(
+                ctx,
                 &[
-                    buffer.as_entire_binding(),
-                    wgpu::BindingResource::TextureView(hdr),
-                    wgpu::BindingResource::TextureView(out),
+                    ("display", buffer.as_entire_binding()),
+                    ("display_hdr", TextureView(hdr)),
+                    ("display_out", TextureView(out)),
                 ],
             )
         });
@@ -177,13 +142,29 @@ impl Display {
         dispatch_2d(
             encoder,
             "display",
-            &self.pipeline,
+            pass.main(),
             &[None, None, None, Some(group)],
             size,
             writes,
         );
     }
 }
+
+/// The pass that composes the clouds over the sky and the host's image (`compose.wgsl`).
+pub static COMPOSE_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "compose",
+    "compose.wgsl",
+    [
+        &crate::shader::MATH_WGSL,
+        &crate::field::gpu::FIELD_WGSL,
+        &crate::frame::FRAME_WGSL,
+        &crate::environment::ENVIRONMENT_WGSL
+    ]
+);
+
+/// The pass that tone-maps the composed image for display (`display.wgsl`).
+pub static DISPLAY_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("display", "display.wgsl", [&tonemap::TONEMAP_WGSL]);
 
 #[cfg(test)]
 mod tests {
@@ -193,7 +174,7 @@ mod tests {
     #[test]
     fn display_uniform_matches_its_wgsl_layout() {
         assert_wgsl_layout!(
-            "display",
+            &crate::post::DISPLAY_WGSL,
             "Display",
             DisplayUniform {
                 exposure_scale,

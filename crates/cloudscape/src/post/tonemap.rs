@@ -146,6 +146,10 @@ pub fn display_rgb8(radiance: Vec3, exposure_ev: f32, op: Tonemap) -> [u8; 3] {
     display.to_array().map(|c| quantize_u8(linear_to_srgb(c)))
 }
 
+/// The tone mapping on the GPU (`tonemap.wgsl`), the twin of this module.
+pub static TONEMAP_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("tonemap", "tonemap.wgsl", []);
+
 #[cfg(test)]
 mod tests {
     use super::*;

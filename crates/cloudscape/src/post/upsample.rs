@@ -3,51 +3,31 @@
 //! pass turns it into the full-resolution output compositing reads, with `upsample.wgsl`'s
 //! bilateral weights (the temporal resolve uses the same estimate).
 
-use crate::frame::{Shared, SharedSlots};
-use crate::gpu::pipeline::{
-    BindGroupCache, UNFILTERABLE_TEXTURE_2D, bind_group, bind_group_layout, compute_pipeline,
-    dispatch_2d, storage_texture_2d,
-};
+use crate::gpu::pipeline::dispatch_2d;
 use crate::gpu::{GpuContext, PassTimer};
-use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT, CloudOutput};
+use crate::output::CloudOutput;
+use crate::pass::{BindGroupCache, ComputePass, Shared};
 
 /// The label the pass is timed under.
 pub const UPSAMPLE_PASS: &str = "upsample";
 
 /// The upsampling pass, made once.
 pub struct Upsampler {
-    slots: SharedSlots,
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    pass: ComputePass,
     group: BindGroupCache,
 }
 
 impl Upsampler {
     /// Builds the pass against the shared groups' layouts.
     pub fn new(ctx: &GpuContext, shared: &Shared) -> Upsampler {
-        let layout = bind_group_layout(
-            &ctx.device,
-            UPSAMPLE_PASS,
-            &[
-                UNFILTERABLE_TEXTURE_2D,
-                UNFILTERABLE_TEXTURE_2D,
-                UNFILTERABLE_TEXTURE_2D,
-                storage_texture_2d(CLOUD_FORMAT),
-                storage_texture_2d(CLOUD_DISTANCE_FORMAT),
-            ],
-        );
-        let slots = SharedSlots::of("upsample_still");
-        let pipeline = compute_pipeline(
-            ctx,
-            UPSAMPLE_PASS,
-            &crate::shader::program("upsample_still"),
-            "upsample_clouds",
-            &shared.layouts(slots, &layout),
-        );
         Upsampler {
-            slots,
-            pipeline,
-            layout,
+            pass: ComputePass::new(
+                ctx,
+                shared,
+                UPSAMPLE_PASS,
+                &UPSAMPLE_STILL_WGSL,
+                &["upsample_clouds"],
+            ),
             group: BindGroupCache::default(),
         }
     }
@@ -62,30 +42,37 @@ impl Upsampler {
         (coarse, full, host_depth): (&CloudOutput, &CloudOutput, &wgpu::TextureView),
         timer: Option<&mut PassTimer>,
     ) {
-        let layout = &self.layout;
+        let pass = &self.pass;
         let views = [host_depth, &coarse.radiance, &full.radiance];
         let group = self.group.get(&views, || {
-            bind_group(
-                &ctx.device,
-                layout,
+            use wgpu::BindingResource::TextureView;
+            pass.group.bind(
+                ctx,
                 &[
-                    wgpu::BindingResource::TextureView(host_depth),
-                    wgpu::BindingResource::TextureView(&coarse.radiance),
-                    wgpu::BindingResource::TextureView(&coarse.distance),
-                    wgpu::BindingResource::TextureView(&full.radiance),
-                    wgpu::BindingResource::TextureView(&full.distance),
+                    ("upsample_host_depth", TextureView(host_depth)),
+                    ("coarse_clouds", TextureView(&coarse.radiance)),
+                    ("coarse_distance", TextureView(&coarse.distance)),
+                    ("upsampled_clouds", TextureView(&full.radiance)),
+                    ("upsampled_distance", TextureView(&full.distance)),
                 ],
             )
         });
         let writes = timer.and_then(|t| t.compute_pass_writes(UPSAMPLE_PASS));
-        let groups = shared.bind_groups(self.slots, group);
+        let groups = shared.bind_groups(pass.slots, group);
         dispatch_2d(
             encoder,
             UPSAMPLE_PASS,
-            &self.pipeline,
+            pass.main(),
             &groups,
             full.size,
             writes,
         );
     }
 }
+
+/// The still-frame upsampling pass (`post/upsample.wgsl`).
+pub static UPSAMPLE_STILL_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "upsample_still",
+    "upsample.wgsl",
+    [&crate::frame::FRAME_WGSL, &crate::temporal::UPSAMPLE_WGSL]
+);

@@ -1,10 +1,11 @@
-#import frame upsample
 // Depth-aware upsampling of a coarse cloud output to full resolution for frames without temporal
 // reuse (post/upsample.rs): every pixel takes upsample.wgsl's estimate, so cloud edges against the
 // host's geometry stay sharp.
 
 @group(3) @binding(0) var upsample_host_depth: texture_2d<f32>;
-// Bindings 1 and 2: the coarse output (upsample.wgsl).
+// The coarse output that upsample.wgsl reads.
+@group(3) @binding(1) var coarse_clouds: texture_2d<f32>;
+@group(3) @binding(2) var coarse_distance: texture_2d<f32>;
 @group(3) @binding(3) var upsampled_clouds: texture_storage_2d<rgba16float, write>;
 @group(3) @binding(4) var upsampled_distance: texture_storage_2d<r32float, write>;
 

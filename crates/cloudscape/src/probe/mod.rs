@@ -1,11 +1,9 @@
 //! GPU probes: every WGSL function with a CPU twin, evaluated at given inputs, so tests hold the
 //! GPU against the CPU specification.
 
-use crate::frame::{Shared, SharedSlots};
-use crate::gpu::pipeline::{
-    UNIFORM, bind_group, bind_group_layout, compute_pipeline, storage_binding, storage_buffer,
-};
+use crate::gpu::pipeline::storage_buffer;
 use crate::gpu::{GpuContext, readback};
+use crate::pass::{ComputePass, Shared};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec4;
 use wgpu::util::DeviceExt;
@@ -94,30 +92,14 @@ pub struct ProbeInput {
 
 /// The probe pipeline, built against the shared groups.
 pub struct Probe {
-    slots: SharedSlots,
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    pass: ComputePass,
 }
 
 impl Probe {
     /// Builds the pipeline.
     pub fn new(ctx: &GpuContext, shared: &Shared) -> Probe {
-        let layout = bind_group_layout(
-            &ctx.device,
-            "probe",
-            &[UNIFORM, storage_binding(true), storage_binding(false)],
-        );
-        let pipeline = compute_pipeline(
-            ctx,
-            "probe",
-            &crate::shader::program("probe"),
-            "probe_functions",
-            &shared.layouts(SharedSlots::of("probe"), &layout),
-        );
         Probe {
-            slots: SharedSlots::of("probe"),
-            pipeline,
-            layout,
+            pass: ComputePass::new(ctx, shared, "probe", &PROBE_WGSL, &["probe_functions"]),
         }
     }
 
@@ -149,20 +131,23 @@ impl Probe {
             wgpu::BufferUsages::STORAGE,
         );
         let output = storage_buffer(ctx, "probe outputs", (inputs.len().max(1) * 16) as u64);
-        let group = bind_group(
-            device,
-            &self.layout,
+        let group = self.pass.group.bind(
+            ctx,
             &[
-                uniform.as_entire_binding(),
-                input.as_entire_binding(),
-                output.as_entire_binding(),
+                ("probe", uniform.as_entire_binding()),
+                ("probe_inputs", input.as_entire_binding()),
+                ("probe_outputs", output.as_entire_binding()),
             ],
         );
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.pipeline);
-            for (slot, g) in shared.bind_groups(self.slots, &group).iter().enumerate() {
+            pass.set_pipeline(self.pass.main());
+            for (slot, g) in shared
+                .bind_groups(self.pass.slots, &group)
+                .iter()
+                .enumerate()
+            {
                 if let Some(g) = g {
                     pass.set_bind_group(slot as u32, *g, &[]);
                 }
@@ -174,6 +159,23 @@ impl Probe {
     }
 }
 
+/// The probe pass (`probe.wgsl`): WGSL functions evaluated at chosen inputs, compared with their CPU twins.
+pub static PROBE_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "probe",
+    "probe.wgsl",
+    [
+        &crate::field::gpu::HIHEIGHT_WGSL,
+        &crate::frame::FRAME_WGSL,
+        &crate::environment::ENVIRONMENT_WGSL,
+        &crate::post::tonemap::TONEMAP_WGSL,
+        &crate::optics::phase::PHASE_WGSL,
+        &crate::optics::slab::SLAB_WGSL,
+        &crate::raymarch::light::MARCH_LIGHT_WGSL,
+        &crate::particles::blend::PARTICLE_BLEND_WGSL,
+        &crate::sprites::views::SPRITE_WGSL
+    ]
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -181,6 +183,10 @@ mod tests {
 
     #[test]
     fn probe_inputs_match_their_wgsl_layout() {
-        assert_wgsl_layout!("probe", "ProbeInput", ProbeInput { a, b, c, d });
+        assert_wgsl_layout!(
+            &crate::probe::PROBE_WGSL,
+            "ProbeInput",
+            ProbeInput { a, b, c, d }
+        );
     }
 }

@@ -1,4 +1,3 @@
-#import hiheight frame environment tonemap phase slab march_light particle_blend sprite
 // Evaluates one WGSL function that has a CPU twin at given inputs, so tests can hold the GPU
 // against the specification (probe/mod.rs lists the functions and their twins).
 

@@ -64,3 +64,23 @@ fn path_depth(
     let length_m = length_m.map_or(SUN_PATH_M.1, |l| l.clamp(SUN_PATH_M.0, SUN_PATH_M.1));
     field.coarse_optical_depth(ray, (0.0, length_m, 2.0), (steps, jitter), time_s)
 }
+
+/// The march's light paths on the GPU (`march_light.wgsl`), the twin of this module.
+pub static MARCH_LIGHT_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "march_light",
+    "march_light.wgsl",
+    [
+        &crate::field::gpu::FIELD_WGSL,
+        &crate::environment::ENVIRONMENT_WGSL
+    ],
+    march_light_constants
+);
+
+/// The light paths' constants as WGSL: the sun path's bounds ([`super::SUN_PATH_M`]).
+fn march_light_constants() -> String {
+    use crate::shader::WgslConst::F32;
+    crate::shader::wgsl_consts([
+        ("MARCH_SUN_PATH_MIN_M", F32(super::SUN_PATH_M.0)),
+        ("MARCH_SUN_PATH_MAX_M", F32(super::SUN_PATH_M.1)),
+    ])
+}

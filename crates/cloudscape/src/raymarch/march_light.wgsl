@@ -1,4 +1,3 @@
-#import field environment
 // The ray marcher's light paths from a point in the clouds, toward the sun and away from it, with
 // their step counts as arguments: no bindings of their own, so the probe evaluates them as the
 // march does (raymarch/light.rs is their CPU twin).

@@ -5,17 +5,12 @@
 pub mod light;
 
 use crate::field::FieldError;
-use crate::frame::{Shared, SharedSlots};
 use crate::gpu::GpuContext;
 use crate::gpu::PassTimer;
 use crate::gpu::late_readback::LateReadback;
-use crate::gpu::pipeline::{
-    BindGroupCache, UNFILTERABLE_TEXTURE_2D, UNIFORM, bind_group, bind_group_layout,
-    compute_pipeline, dispatch_2d_repeated, storage_binding, storage_buffer, storage_texture_2d,
-    uniform_buffer,
-};
+use crate::gpu::pipeline::{dispatch_2d_repeated, storage_buffer, uniform_buffer};
 use crate::optics::{Octaves, PhaseLobes, SunSlab};
-use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
+use crate::pass::{BindGroupCache, ComputePass, Shared};
 use crate::scene::{LightingModel, Quality, Scene};
 use crate::technique::{Draws, FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use bytemuck::{Pod, Zeroable};
@@ -159,17 +154,12 @@ struct MarchSum {
     reserved: UVec2,
 }
 
-/// The counters' and sums' binding.
-const READ_WRITE: wgpu::BindingType = storage_binding(false);
-
 /// Bytes of the counters: view-ray density samples, texels marched.
 const STATS_BYTES: u64 = 8;
 
 /// The ray marcher: one compute pass, made once.
 pub struct RaymarchRenderer {
-    slots: SharedSlots,
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    pass: ComputePass,
     march: wgpu::Buffer,
     stats: wgpu::Buffer,
     stats_readback: LateReadback,
@@ -181,30 +171,8 @@ pub struct RaymarchRenderer {
 impl RaymarchRenderer {
     /// Builds the pipeline against the shared groups' layouts.
     pub fn new(ctx: &GpuContext, shared: &Shared) -> RaymarchRenderer {
-        let depth = UNFILTERABLE_TEXTURE_2D;
-        let layout = bind_group_layout(
-            &ctx.device,
-            "raymarch",
-            &[
-                UNIFORM,
-                depth,
-                storage_texture_2d(CLOUD_FORMAT),
-                READ_WRITE,
-                storage_texture_2d(CLOUD_DISTANCE_FORMAT),
-                READ_WRITE,
-            ],
-        );
-        let pipeline = compute_pipeline(
-            ctx,
-            "raymarch",
-            &crate::shader::program("raymarch"),
-            "march_clouds",
-            &shared.layouts(SharedSlots::of("raymarch"), &layout),
-        );
         RaymarchRenderer {
-            slots: SharedSlots::of("raymarch"),
-            pipeline,
-            layout,
+            pass: ComputePass::new(ctx, shared, "raymarch", &RAYMARCH_WGSL, &["march_clouds"]),
             march: uniform_buffer(ctx, "raymarch settings", size_of::<MarchUniform>() as u64),
             stats: storage_buffer(ctx, "raymarch stats", STATS_BYTES),
             stats_readback: LateReadback::new(ctx, "raymarch stats readback", STATS_BYTES),
@@ -285,21 +253,21 @@ impl Technique for RaymarchRenderer {
                 .write_buffer(&self.march, 0, bytemuck::bytes_of(&self.settings));
         }
         self.ensure_sums(ctx, size.x * size.y);
-        let (march, stats, sums, layout) = (&self.march, &self.stats, &self.sums, &self.layout);
+        let (march, stats, sums, pass) = (&self.march, &self.stats, &self.sums, &self.pass);
         let output = targets.output;
         let group = self.group.get(
             &[targets.host_depth, &output.radiance, &output.distance],
             || {
-                bind_group(
-                    &ctx.device,
-                    layout,
+                use wgpu::BindingResource::TextureView;
+                pass.group.bind(
+                    ctx,
                     &[
-                        march.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(targets.host_depth),
-                        wgpu::BindingResource::TextureView(&output.radiance),
-                        stats.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(&output.distance),
-                        sums.as_entire_binding(),
+                        ("march", march.as_entire_binding()),
+                        ("host_depth", TextureView(targets.host_depth)),
+                        ("cloud_out", TextureView(&output.radiance)),
+                        ("march_stats", stats.as_entire_binding()),
+                        ("cloud_distance_out", TextureView(&output.distance)),
+                        ("march_sums", sums.as_entire_binding()),
                     ],
                 )
             },
@@ -308,8 +276,8 @@ impl Technique for RaymarchRenderer {
         dispatch_2d_repeated(
             encoder,
             "raymarch",
-            &self.pipeline,
-            &shared.bind_groups(self.slots, group),
+            pass.main(),
+            &shared.bind_groups(pass.slots, group),
             (size, self.settings.samples_per_pixel),
             writes,
         );
@@ -331,6 +299,20 @@ impl Technique for RaymarchRenderer {
     }
 }
 
+/// The ray marcher's pass (`raymarch.wgsl`).
+pub static RAYMARCH_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "raymarch",
+    "raymarch.wgsl",
+    [
+        &crate::field::gpu::HIHEIGHT_WGSL,
+        &crate::frame::FRAME_WGSL,
+        &crate::environment::ENVIRONMENT_WGSL,
+        &crate::optics::phase::PHASE_WGSL,
+        &crate::optics::slab::SLAB_WGSL,
+        &light::MARCH_LIGHT_WGSL
+    ]
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -339,7 +321,7 @@ mod tests {
     #[test]
     fn march_uniforms_match_their_wgsl_layouts() {
         assert_wgsl_layout!(
-            "raymarch",
+            &crate::raymarch::RAYMARCH_WGSL,
             "March",
             MarchUniform {
                 primary_steps,
@@ -362,7 +344,7 @@ mod tests {
             }
         );
         assert_wgsl_layout!(
-            "raymarch",
+            &crate::raymarch::RAYMARCH_WGSL,
             "MarchSum",
             MarchSum {
                 radiance_transmittance,

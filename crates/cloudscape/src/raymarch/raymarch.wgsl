@@ -1,4 +1,3 @@
-#import hiheight frame environment phase slab march_light
 // Ray-marched clouds: per output texel, in-scattered radiance, transmittance and distance of the
 // cloud field along the view ray, up to the host's depth buffer (the cloud-output contract,
 // output/mod.rs). No haze: the compositor applies aerial perspective at the cloud distance.

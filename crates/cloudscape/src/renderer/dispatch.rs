@@ -1,8 +1,8 @@
 //! The one place that knows every technique: builds the one a scene names.
 
-use crate::frame::Shared;
 use crate::gpu::GpuContext;
 use crate::particles::render::ParticleRenderer;
+use crate::pass::Shared;
 use crate::raymarch::RaymarchRenderer;
 use crate::scene::Technique as TechniqueName;
 use crate::sprites::SpriteRenderer;

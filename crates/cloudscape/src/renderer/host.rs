@@ -15,10 +15,11 @@ pub use crate::field::gpu::FieldUpdate;
 
 use crate::field::gpu::FieldGpu;
 use crate::field::{CloudField, FieldError};
-use crate::frame::{Frame, FrameGpu, FrameSettings, Shared};
+use crate::frame::{Frame, FrameGpu, FrameSettings};
 use crate::gpu::pipeline::{STORAGE_OUTPUT, texture_2d};
 use crate::gpu::{GpuContext, PassTimer};
 use crate::output::{CloudOutput, SampleGrid};
+use crate::pass::Shared;
 use crate::post::upsample::Upsampler;
 use crate::post::{Background, Compositor, DISPLAY_FORMAT, Display, HDR_FORMAT};
 use crate::scene::Scene;
@@ -436,8 +437,9 @@ impl CloudRenderer {
             frame: &self.frame_gpu,
             environment: &self.environment_gpu,
         };
+        let groups = (&shared, &self.environment_gpu);
         self.environment_passes
-            .encode(ctx, encoder, &shared, (env, self.shadow_rebuild), timer);
+            .encode(ctx, encoder, groups, (env, self.shadow_rebuild), timer);
         *pending = false;
     }
 

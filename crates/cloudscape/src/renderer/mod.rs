@@ -233,3 +233,24 @@ pub fn read_back(ctx: &GpuContext, images: &FrameImages) -> Rendered {
     };
     Rendered { hdr, ldr }
 }
+
+/// The root WGSL module of every program the crate builds (each with entry points), for tools and
+/// tests: every `.wgsl` file of the crate is reached from one of them.
+pub static PROGRAMS: &[&crate::shader::WgslModule] = &[
+    &crate::field::gpu::NOISE_GEN_WGSL,
+    &crate::environment::ATMOSPHERE_LUTS_WGSL,
+    &crate::environment::ATMOSPHERE_AERIAL_WGSL,
+    &crate::environment::CLOUD_SHADOW_WGSL,
+    &crate::raymarch::RAYMARCH_WGSL,
+    &crate::temporal::TEMPORAL_WGSL,
+    &crate::post::upsample::UPSAMPLE_STILL_WGSL,
+    &crate::post::COMPOSE_WGSL,
+    &crate::post::DISPLAY_WGSL,
+    &crate::probe::PROBE_WGSL,
+    &crate::particles::gpu::PARTICLE_BAKE_WGSL,
+    &crate::particles::generate_gpu::PARTICLE_GENERATE_WGSL,
+    &crate::particles::render::PARTICLE_RENDER_WGSL,
+    &crate::sprites::render::SPRITE_RENDER_WGSL,
+    &crate::sprites::render::SPRITE_IMPOSTOR_WGSL,
+    &crate::sprites::render::SPRITE_RESOLVE_WGSL,
+];

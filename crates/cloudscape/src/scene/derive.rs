@@ -8,9 +8,7 @@ use toml::de::DeTable;
 
 use super::metar::{self, SceneWeather};
 use super::source_map::SourceMap;
-use super::{Scene, SceneError, load, locate};
-use crate::animation::solar_position;
-use crate::field::MAX_LAYERS;
+use super::{MAX_LAYERS, Scene, SceneError, load, locate, solar_position};
 
 /// Each value a scene derives others from, and the keys it derives: a document gives one or the
 /// other, and a `--set` of the source replaces what the file gave of them

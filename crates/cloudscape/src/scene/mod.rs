@@ -15,6 +15,7 @@ pub mod metar;
 mod model;
 mod overrides;
 mod save;
+mod solar;
 mod source_map;
 mod validate;
 
@@ -22,6 +23,11 @@ use std::path::{Path, PathBuf};
 
 pub use error::SceneError;
 pub use model::*;
+pub(crate) use solar::angles_of;
+pub use solar::{
+    SunAngles, declination_rad, direction_from_angles_deg, key_direction, solar_direction,
+    solar_position,
+};
 use source_map::SourceMap;
 
 /// Parses a TOML document other than a scene (a sprite model file) with the scene's located

@@ -132,7 +132,7 @@ pub struct Sun {
 }
 
 /// A moment and a place on Earth, which put the sun on the sky (see
-/// [`crate::animation::solar_position`]).
+/// [`super::solar_position`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields)]
 pub struct TimeOfDay {
@@ -303,12 +303,30 @@ impl Default for CloudTypeMix {
     }
 }
 
+/// Density-height gradients of the four types of a [`CloudTypeMix`] (the anchor types of the cloud
+/// field's type axis, `field::profile`) as (rise start, rise end, fall start, fall end),
+/// fractions of the layer thickness. Stratus and stratocumulus are VolumeCloud's fallback gradients
+/// (peers.md, from yangrc1234/VolumeCloud). Cumulus rises as fast as VolumeCloud's but thins from 20 %
+/// of the layer to its top instead of holding full density to 75 %: thresholded by coverage, a long
+/// linear fall gives domed tops where a plateau gives flat-topped slabs (tuned by eye on the default
+/// scene). Cumulonimbus fills the layer like Schneider 2015's towering type.
+pub const TYPE_GRADIENTS: [[f32; 4]; 4] = [
+    [0.0, 0.07, 0.08, 0.15],
+    [0.0, 0.2, 0.42, 0.6],
+    [0.0, 0.1, 0.2, 1.0],
+    [0.0, 0.05, 0.9, 1.0],
+];
+
 fn cumulus_only() -> CloudTypeMix {
     CloudTypeMix {
         cumulus: 1.0,
         ..CloudTypeMix::default()
     }
 }
+
+/// Most cloud layers a scene can draw: one cloud field holds at most this many (the GPU uniform's
+/// array size).
+pub const MAX_LAYERS: usize = 4;
 
 /// One layer of clouds between two altitudes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
@@ -488,6 +506,19 @@ impl Default for PhaseFunction {
             g_forward: 0.8,
             g_back: -0.3,
             forward_weight: 0.7,
+        }
+    }
+}
+
+impl crate::optics::PhaseLobes {
+    /// The lobes of a scene's phase-function settings.
+    pub fn from_scene(p: &PhaseFunction) -> Self {
+        match p.model {
+            PhaseModel::Mie => Self::approximate_mie(p.droplet_diameter_um),
+            PhaseModel::Hg => Self::henyey_greenstein(p.g),
+            PhaseModel::DualHg => {
+                Self::dual_henyey_greenstein(p.g_forward, p.g_back, p.forward_weight)
+            }
         }
     }
 }
@@ -731,6 +762,32 @@ pub enum SpriteLod {
     Billboards,
 }
 
+/// A cloud type of the sprite technique.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CloudType {
+    /// Small, flat fair-weather puffs (cumulus fractus).
+    FairWeather,
+    /// Cumulus humilis: wider than tall.
+    CumulusHumilis,
+    /// Cumulus mediocris: about as tall as wide.
+    CumulusMediocris,
+    /// Cumulus congestus: towering, taller than wide.
+    CumulusCongestus,
+    /// Cumulonimbus: a tower to the layer top with a spreading anvil.
+    Cumulonimbus,
+    /// Stratocumulus: broad, lumpy rolls.
+    Stratocumulus,
+    /// Stratus: a flat, blurry sheet.
+    Stratus,
+    /// Altocumulus: small lumpy cloudlets high up.
+    Altocumulus,
+    /// Altostratus: a thin, wispy high sheet.
+    Altostratus,
+    /// Nimbostratus: a thick, dark, blurry deck.
+    Nimbostratus,
+}
+
 /// A hand-made sprite cloud (Wang 2003, "Cloud creation": an artist builds the shape from boxes,
 /// and a script fills them with sprites). Unset artist parameters come from the type's recipe.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
@@ -740,7 +797,7 @@ pub struct SpriteCloudSpec {
     /// `cumulus_congestus`, `cumulonimbus`, `stratocumulus`, `stratus`, `altocumulus`,
     /// `altostratus` or `nimbostratus`.
     #[serde(rename = "type")]
-    pub cloud_type: crate::sprites::CloudType,
+    pub cloud_type: CloudType,
     /// Centre of the cloud, m.
     pub center_m: [f32; 3],
     /// The boxes, relative to the centre; at least one.

@@ -3,8 +3,7 @@
 
 use std::path::Path;
 
-use super::Scene;
-use crate::animation::solar_position;
+use super::{Scene, solar_position};
 use crate::fsutil::write_bytes_atomically;
 
 /// Values a scene derives from another key, which a file must leave out when it gives that key:

@@ -3,8 +3,7 @@
 
 use std::fmt;
 
-use crate::animation::key_direction;
-
+use super::key_direction;
 use super::knobs::{self, Field, Knob};
 use super::model::{
     CameraKey, CloudLayer, CoverageKey, Scene, SpriteCloudSpec, SunKey, VolumeGrid, WeatherSource,
@@ -465,7 +464,7 @@ fn check_number<T>(
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
-    use crate::scene::model::{Animation, SpriteBoxSpec, TimeOfDay, VolumeGrid};
+    use crate::scene::model::{Animation, CloudType, SpriteBoxSpec, TimeOfDay, VolumeGrid};
 
     /// Two camera keyframes 10 s apart that look at a point, two sun and two coverage keyframes.
     pub(in crate::scene) fn two_key_animation() -> Animation {
@@ -501,7 +500,7 @@ pub(super) mod tests {
         scene.sprites.directional_color = Some([2.5, 2.4, 2.2]);
         scene.sprites.model = Some("clouds.sprites.toml".into());
         scene.sprite_clouds.push(SpriteCloudSpec {
-            cloud_type: crate::sprites::CloudType::CumulusMediocris,
+            cloud_type: CloudType::CumulusMediocris,
             center_m: [0.0, 1800.0, -6000.0],
             boxes: vec![SpriteBoxSpec {
                 center_m: [0.0; 3],

@@ -12,8 +12,6 @@
 //! by reading the column through it: `environment_cloud_sun_optical_depth(p)` in
 //! `environment.wgsl`, which [`CloudShadowMap::optical_depth`] specifies.
 
-pub mod gpu;
-
 use crate::field::CloudField;
 use crate::scene::{PlanetShape, Scene};
 use glam::{Vec2, Vec3};

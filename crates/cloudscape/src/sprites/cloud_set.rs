@@ -387,7 +387,7 @@ mod tests {
     #[test]
     fn sprite_records_match_their_wgsl_layout() {
         assert_wgsl_layout!(
-            "sprite_render",
+            &crate::sprites::render::SPRITE_RENDER_WGSL,
             "Sprite",
             GpuSprite {
                 position_m,
@@ -402,7 +402,7 @@ mod tests {
             }
         );
         assert_wgsl_layout!(
-            "sprite_render",
+            &crate::sprites::render::SPRITE_RENDER_WGSL,
             "Cloud",
             GpuCloud {
                 colors,

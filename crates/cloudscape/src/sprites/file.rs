@@ -8,8 +8,7 @@ use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
 use super::model::{Sprite, SpriteBox, SpriteCloud};
-use super::types::CloudType;
-use crate::scene::{SceneError, SpriteBoxSpec, parse_toml_document};
+use crate::scene::{CloudType, SceneError, SpriteBoxSpec, parse_toml_document};
 
 /// The `format` line of every sprite model file.
 pub const FORMAT: &str = "cloudscape sprite model";

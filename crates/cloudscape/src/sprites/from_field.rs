@@ -20,10 +20,10 @@ use glam::{IVec2, Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::model::{SpriteBox, SpriteCloud, assign_groups, cull, dress, unit_random};
-use super::types::CloudType;
 use crate::field::noise::pcg_hash;
 use crate::field::{CloudField, LayerField, profile};
 use crate::particles::generate::world_point;
+use crate::scene::CloudType;
 
 /// Normalised coarse density (of the layer's densest) over which a sprite's opacity ramps from 0
 /// to full: its presence, `saturate(density / ramp)`.

@@ -25,4 +25,3 @@ pub mod views;
 pub use file::ModelFile;
 pub use model::{CloudModel, Sprite, SpriteBox, SpriteCloud};
 pub use render::SpriteRenderer;
-pub use types::CloudType;

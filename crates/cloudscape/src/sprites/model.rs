@@ -6,8 +6,9 @@
 use glam::{Vec2, Vec3};
 
 use super::textures::texture_in;
-use super::types::{CloudType, Recipe};
+use super::types::Recipe;
 use crate::field::noise::{hash_to_unit, pcg_hash};
+use crate::scene::CloudType;
 
 /// An axis-aligned box of a cloud model, relative to the cloud's centre.
 #[derive(Clone, Copy, Debug, PartialEq)]

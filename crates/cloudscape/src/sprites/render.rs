@@ -17,15 +17,14 @@ use super::views::{
     sort_view, wind_offsets_m,
 };
 use crate::field::FieldError;
-use crate::frame::{Shared, SharedSlots};
 use crate::gpu::pipeline::{
-    BindGroupCache, PREMULTIPLIED_OVER, RasterDescriptor, UNFILTERABLE_TEXTURE_2D, UNIFORM,
-    bind_group, bind_group_layout, compute_pipeline, dispatch_2d, float_texture, render_pipeline,
-    storage_binding, storage_buffer, storage_texture_2d, uniform_buffer,
+    PREMULTIPLIED_OVER, RasterDescriptor, dispatch_2d, storage_buffer, uniform_buffer,
 };
 use crate::gpu::{GpuContext, PassTimer};
 use crate::optics::PhaseLobes;
-use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT};
+use crate::pass::{BindGroupCache, ComputePass, RasterPass, Shared};
+use crate::shader::WgslModule;
+
 use crate::scene::Scene;
 use crate::technique::{Draws, FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 
@@ -143,7 +142,7 @@ struct Ring {
     sectors: [Option<SectorView>; SECTORS],
     views: Vec<ViewBuffers>,
     uniform: wgpu::Buffer,
-    group: Option<(wgpu::TextureView, wgpu::BindGroup)>,
+    group: BindGroupCache,
     sector_groups: Vec<Option<wgpu::BindGroup>>,
     /// Sectors to render this frame.
     pending: Vec<usize>,
@@ -183,7 +182,7 @@ impl Ring {
                 "impostor ring",
                 (SECTORS * size_of::<GpuSector>()) as u64,
             ),
-            group: None,
+            group: BindGroupCache::default(),
             sector_groups: vec![None; SECTORS],
             pending: Vec::new(),
         }
@@ -191,7 +190,7 @@ impl Ring {
 
     /// Forgets the bind groups (a buffer they bind was replaced).
     fn forget_groups(&mut self) {
-        self.group = None;
+        self.group.clear();
         self.sector_groups.iter_mut().for_each(|g| *g = None);
     }
 
@@ -224,13 +223,9 @@ pub struct SpriteStats {
 
 /// The sprite technique.
 pub struct SpriteRenderer {
-    slots: [SharedSlots; 3],
-    sprite_layout: wgpu::BindGroupLayout,
-    impostor_layout: wgpu::BindGroupLayout,
-    resolve_layout: wgpu::BindGroupLayout,
-    sprite_pipeline: wgpu::RenderPipeline,
-    impostor_pipeline: wgpu::RenderPipeline,
-    resolve_pipeline: wgpu::ComputePipeline,
+    sprite_pass: RasterPass,
+    impostor_pass: RasterPass,
+    resolve_pass: ComputePass,
     settings: wgpu::Buffer,
     resolve: wgpu::Buffer,
     sheet: wgpu::TextureView,
@@ -241,7 +236,7 @@ pub struct SpriteRenderer {
     ring: Option<Ring>,
     ring_radius_m: f32,
     targets: Option<RasterTargets>,
-    main_group: Option<(wgpu::TextureView, wgpu::BindGroup)>,
+    main_group: BindGroupCache,
     no_depth: wgpu::TextureView,
     resolve_groups: BindGroupCache,
     stats: SpriteStats,
@@ -273,90 +268,31 @@ impl SpriteRenderer {
     /// Builds the passes against the shared groups' layouts and bakes the puff sheet; the clouds
     /// come with [`Technique::configure`].
     pub fn new(ctx: &GpuContext, shared: &Shared) -> SpriteRenderer {
-        let filterable = float_texture(wgpu::TextureViewDimension::D2);
-        let sampler_type = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
-        let read_only = storage_binding(true);
-        let device = &ctx.device;
-        let sprite_layout = bind_group_layout(
-            device,
-            "sprites",
-            &[
-                UNIFORM,
-                UNIFORM,
-                read_only,
-                read_only,
-                read_only,
-                filterable,
-                sampler_type,
-                UNFILTERABLE_TEXTURE_2D,
-            ],
-        );
-        let array = float_texture(wgpu::TextureViewDimension::D2Array);
-        let impostor_layout = bind_group_layout(
-            device,
-            "sprite impostors",
-            &[
-                UNIFORM,
-                UNIFORM,
-                array,
-                array,
-                sampler_type,
-                UNFILTERABLE_TEXTURE_2D,
-            ],
-        );
-        let resolve_layout = bind_group_layout(
-            device,
-            "sprite resolve",
-            &[
-                UNIFORM,
-                UNFILTERABLE_TEXTURE_2D,
-                UNFILTERABLE_TEXTURE_2D,
-                storage_texture_2d(CLOUD_FORMAT),
-                storage_texture_2d(CLOUD_DISTANCE_FORMAT),
-            ],
-        );
-        let slots = ["sprite_render", "sprite_impostor", "sprite_resolve"].map(SharedSlots::of);
         let blended = Some(wgpu::ColorTargetState {
             format: TARGET_FORMAT,
             blend: Some(PREMULTIPLIED_OVER),
             write_mask: wgpu::ColorWrites::ALL,
         });
-        let raster = |program: &str, entries, layout| {
-            let source = crate::shader::program(program);
-            render_pipeline(
-                ctx,
-                &RasterDescriptor {
-                    label: program,
-                    source: &source,
-                    entries,
-                    targets: &[blended.clone(), blended.clone()],
-                    depth: None,
-                    topology: wgpu::PrimitiveTopology::TriangleStrip,
-                },
-                &shared.layouts(SharedSlots::of(program), layout),
-            )
+        let raster = |root: &'static WgslModule, entries| {
+            let descriptor = RasterDescriptor {
+                label: root.name,
+                entries,
+                targets: &[blended.clone(), blended.clone()],
+                depth: None,
+                topology: wgpu::PrimitiveTopology::TriangleStrip,
+            };
+            RasterPass::new(ctx, shared, root, &descriptor)
         };
-        let sprite_pipeline = raster("sprite_render", ("vs_sprite", "fs_sprite"), &sprite_layout);
-        let impostor_pipeline = raster(
-            "sprite_impostor",
-            ("vs_impostor", "fs_impostor"),
-            &impostor_layout,
-        );
-        let resolve_pipeline = compute_pipeline(
-            ctx,
-            "sprite resolve",
-            &crate::shader::program("sprite_resolve"),
-            "resolve_sprites",
-            &shared.layouts(slots[2], &resolve_layout),
-        );
         SpriteRenderer {
-            slots,
-            sprite_layout,
-            impostor_layout,
-            resolve_layout,
-            sprite_pipeline,
-            impostor_pipeline,
-            resolve_pipeline,
+            sprite_pass: raster(&SPRITE_RENDER_WGSL, ("vs_sprite", "fs_sprite")),
+            impostor_pass: raster(&SPRITE_IMPOSTOR_WGSL, ("vs_impostor", "fs_impostor")),
+            resolve_pass: ComputePass::new(
+                ctx,
+                shared,
+                "sprite resolve",
+                &SPRITE_RESOLVE_WGSL,
+                &["resolve_sprites"],
+            ),
             settings: uniform_buffer(ctx, "sprite settings", size_of::<SettingsUniform>() as u64),
             resolve: uniform_buffer(ctx, "sprite resolve", 16),
             sheet: upload_sheet(ctx),
@@ -372,7 +308,7 @@ impl SpriteRenderer {
             ring: None,
             ring_radius_m: 0.0,
             targets: None,
-            main_group: None,
+            main_group: BindGroupCache::default(),
             no_depth: crate::gpu::pipeline::texture_2d(
                 ctx,
                 "no host depth",
@@ -428,7 +364,7 @@ impl SpriteRenderer {
             buffer("sprites", bytemuck::cast_slice(sprites)),
             buffer("sprite clouds", bytemuck::cast_slice(clouds)),
         ));
-        self.main_group = None;
+        self.main_group.clear();
         if let Some(ring) = self.ring.as_mut() {
             ring.forget_groups();
         }
@@ -501,18 +437,18 @@ impl SpriteRenderer {
         depth: &wgpu::TextureView,
     ) -> wgpu::BindGroup {
         let (_, sprites, clouds) = self.uploaded.as_ref().expect("uploaded in prepare");
-        bind_group(
-            &ctx.device,
-            &self.sprite_layout,
+        use wgpu::BindingResource::{Sampler, TextureView};
+        self.sprite_pass.group.bind(
+            ctx,
             &[
-                view.uniform.as_entire_binding(),
-                self.settings.as_entire_binding(),
-                sprites.as_entire_binding(),
-                clouds.as_entire_binding(),
-                view.order.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&self.sheet),
-                wgpu::BindingResource::Sampler(&self.sampler),
-                wgpu::BindingResource::TextureView(depth),
+                ("view", view.uniform.as_entire_binding()),
+                ("settings", self.settings.as_entire_binding()),
+                ("sprites", sprites.as_entire_binding()),
+                ("clouds", clouds.as_entire_binding()),
+                ("order", view.order.as_entire_binding()),
+                ("puffs", TextureView(&self.sheet)),
+                ("puff_sampler", Sampler(&self.sampler)),
+                ("host_depth", TextureView(depth)),
             ],
         )
     }
@@ -545,10 +481,11 @@ impl SpriteRenderer {
             };
             let (radiance, distance) = &ring.layers[k];
             let mut pass = begin_targets(encoder, "sprite impostor", (radiance, distance), writes);
+            let sprites = &self.sprite_pass;
             draw_sprites(
                 &mut pass,
-                &self.sprite_pipeline,
-                &shared.bind_groups(self.slots[0], group),
+                &sprites.pipeline,
+                &shared.bind_groups(sprites.slots, group),
                 ring.views[k].count,
             );
         }
@@ -711,7 +648,7 @@ impl Technique for SpriteRenderer {
         };
         let sorted = sort_view(&self.set, &offsets, (eye, frame.clip_from_world()), reach);
         if self.main.write(ctx, &view, &sorted) {
-            self.main_group = None;
+            self.main_group.clear();
         }
         self.prepare_ring(ctx, &views, eye, frame.time_s, &offsets);
         self.stats = SpriteStats {
@@ -749,16 +686,14 @@ impl Technique for SpriteRenderer {
             self.targets = Some(RasterTargets::single(ctx, output.size));
             self.resolve_groups.clear();
         }
-        if self
-            .main_group
-            .as_ref()
-            .is_none_or(|(view, _)| view != targets.host_depth)
-        {
-            let group = self.sprite_group(ctx, &self.main, targets.host_depth);
-            self.main_group = Some((targets.host_depth.clone(), group));
-        }
+        let mut main_group = std::mem::take(&mut self.main_group);
+        let group = main_group
+            .get(&[targets.host_depth], || {
+                self.sprite_group(ctx, &self.main, targets.host_depth)
+            })
+            .clone();
+        self.main_group = main_group;
         let raster = self.targets.as_ref().expect("made above");
-        let group = &self.main_group.as_ref().expect("made above").1;
         {
             let writes = timer
                 .as_deref_mut()
@@ -770,59 +705,51 @@ impl Technique for SpriteRenderer {
                 writes,
             );
             pass.set_scissor_rect(origin.x, origin.y, size.x, size.y);
+            let (impostors, sprites) = (&self.impostor_pass, &self.sprite_pass);
             if let Some(ring) = self.ring.as_mut() {
-                if ring
-                    .group
-                    .as_ref()
-                    .is_none_or(|(view, _)| view != targets.host_depth)
-                {
-                    ring.group = None;
-                }
-                let (_, ring_group) = ring.group.get_or_insert_with(|| {
-                    (
-                        targets.host_depth.clone(),
-                        bind_group(
-                            &ctx.device,
-                            &self.impostor_layout,
-                            &[
-                                self.main.uniform.as_entire_binding(),
-                                ring.uniform.as_entire_binding(),
-                                wgpu::BindingResource::TextureView(&ring.radiance_array),
-                                wgpu::BindingResource::TextureView(&ring.distance_array),
-                                wgpu::BindingResource::Sampler(&self.sampler),
-                                wgpu::BindingResource::TextureView(targets.host_depth),
-                            ],
-                        ),
+                let ring_group = ring.group.get(&[targets.host_depth], || {
+                    use wgpu::BindingResource::{Sampler, TextureView};
+                    impostors.group.bind(
+                        ctx,
+                        &[
+                            ("view", self.main.uniform.as_entire_binding()),
+                            ("ring", ring.uniform.as_entire_binding()),
+                            ("impostor_radiance", TextureView(&ring.radiance_array)),
+                            ("impostor_distance", TextureView(&ring.distance_array)),
+                            ("impostor_sampler", Sampler(&self.sampler)),
+                            ("host_depth", TextureView(targets.host_depth)),
+                        ],
                     )
                 });
                 draw_sprites(
                     &mut pass,
-                    &self.impostor_pipeline,
-                    &shared.bind_groups(self.slots[1], ring_group),
+                    &impostors.pipeline,
+                    &shared.bind_groups(impostors.slots, ring_group),
                     SECTORS as u32,
                 );
             }
             draw_sprites(
                 &mut pass,
-                &self.sprite_pipeline,
-                &shared.bind_groups(self.slots[0], group),
+                &sprites.pipeline,
+                &shared.bind_groups(sprites.slots, &group),
                 self.main.count,
             );
         }
         ctx.queue
             .write_buffer(&self.resolve, 0, bytemuck::cast_slice(&[origin, size]));
+        let resolve = &self.resolve_pass;
         let resolve_group = self
             .resolve_groups
             .get(&[&output.radiance, &output.distance], || {
-                bind_group(
-                    &ctx.device,
-                    &self.resolve_layout,
+                use wgpu::BindingResource::TextureView;
+                resolve.group.bind(
+                    ctx,
                     &[
-                        self.resolve.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(&raster.radiance),
-                        wgpu::BindingResource::TextureView(&raster.distance),
-                        wgpu::BindingResource::TextureView(&output.radiance),
-                        wgpu::BindingResource::TextureView(&output.distance),
+                        ("resolve", self.resolve.as_entire_binding()),
+                        ("accumulated", TextureView(&raster.radiance)),
+                        ("accumulated_distance", TextureView(&raster.distance)),
+                        ("cloud_out", TextureView(&output.radiance)),
+                        ("cloud_distance_out", TextureView(&output.distance)),
                     ],
                 )
             });
@@ -830,8 +757,8 @@ impl Technique for SpriteRenderer {
         dispatch_2d(
             encoder,
             "sprite resolve",
-            &self.resolve_pipeline,
-            &shared.bind_groups(self.slots[2], resolve_group),
+            resolve.main(),
+            &shared.bind_groups(resolve.slots, resolve_group),
             size,
             writes,
         );
@@ -849,6 +776,33 @@ impl Technique for SpriteRenderer {
     }
 }
 
+/// The sprites' render pass (`sprite_render.wgsl`).
+pub static SPRITE_RENDER_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "sprite_render",
+    "sprite_render.wgsl",
+    [
+        &crate::shader::MATH_WGSL,
+        &crate::frame::FRAME_WGSL,
+        &crate::environment::ENVIRONMENT_WGSL,
+        &crate::optics::phase::PHASE_WGSL,
+        &super::views::SPRITE_WGSL
+    ]
+);
+
+/// The pass that renders impostors (`sprite_impostor.wgsl`).
+pub static SPRITE_IMPOSTOR_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "sprite_impostor",
+    "sprite_impostor.wgsl",
+    [&crate::frame::FRAME_WGSL, &super::views::SPRITE_WGSL]
+);
+
+/// The pass that resolves the sprites into the cloud output (`sprite_resolve.wgsl`).
+pub static SPRITE_RESOLVE_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "sprite_resolve",
+    "sprite_resolve.wgsl",
+    [&super::views::SPRITE_WGSL]
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -857,7 +811,7 @@ mod tests {
     #[test]
     fn uniforms_match_their_wgsl_layout() {
         assert_wgsl_layout!(
-            "sprite_render",
+            &crate::sprites::render::SPRITE_RENDER_WGSL,
             "Settings",
             SettingsUniform {
                 wind_offset_m,
@@ -873,7 +827,7 @@ mod tests {
             }
         );
         assert_wgsl_layout!(
-            "sprite_impostor",
+            &crate::sprites::render::SPRITE_IMPOSTOR_WGSL,
             "Sector",
             GpuSector {
                 corners_m,

@@ -1,4 +1,3 @@
-#import frame
 // What the sprite passes share (sprites/render.rs): the view a pass draws from, the host-depth
 // test, and the two blended targets every sprite pass writes.
 

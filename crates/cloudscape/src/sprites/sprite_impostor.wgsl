@@ -1,4 +1,3 @@
-#import frame sprite
 // The impostor ring in the main pass (sprites/impostors.rs): each of the 8 sectors' quads, at the
 // ring radius from the eye it was rendered from, textured with the clouds beyond the ring as that
 // eye saw them. Drawn first, behind every sprite within the ring.

@@ -1,4 +1,3 @@
-#import constants frame environment phase sprite
 // The sprite pass (sprites/render.rs): every sprite of the view's sorted list, back to front, as
 // a textured quad blended over the ones behind it. Shading follows Wang 2003 with physically
 // derived numbers (sprites/shading.rs, the CPU specification); the in-cloud lock, fades and

@@ -1,4 +1,3 @@
-#import sprite
 // Turns the sprite pass's blended targets into the cloud-output contract (output/mod.rs): the
 // premultiplied radiance with transmittance 1 - opacity, and the opacity-weighted mean distance.
 

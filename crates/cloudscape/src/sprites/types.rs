@@ -1,37 +1,10 @@
-//! The ten cloud types of the sprite technique (Wang 2003, "Real-world cloud types": MSFS 2004
-//! models ten, `../shared/references/peers.md`), each a recipe: the shape of its boxes, how many
-//! sprites fill them, how large and how turned the sprites are, which of the 16 puff textures
-//! they wear, and how dense the cluster is (its cull radius).
-
-use serde::{Deserialize, Serialize};
+//! The ten cloud types of the sprite technique ([`CloudType`]; Wang 2003, "Real-world cloud
+//! types": MSFS 2004 models ten, `../shared/references/peers.md`), each a recipe: the shape of its
+//! boxes, how many sprites fill them, how large and how turned the sprites are, which of the 16
+//! puff textures they wear, and how dense the cluster is (its cull radius).
 
 use super::textures::{BLURRY, SOLID, WISPY};
-
-/// A cloud type of the sprite technique.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CloudType {
-    /// Small, flat fair-weather puffs (cumulus fractus).
-    FairWeather,
-    /// Cumulus humilis: wider than tall.
-    CumulusHumilis,
-    /// Cumulus mediocris: about as tall as wide.
-    CumulusMediocris,
-    /// Cumulus congestus: towering, taller than wide.
-    CumulusCongestus,
-    /// Cumulonimbus: a tower to the layer top with a spreading anvil.
-    Cumulonimbus,
-    /// Stratocumulus: broad, lumpy rolls.
-    Stratocumulus,
-    /// Stratus: a flat, blurry sheet.
-    Stratus,
-    /// Altocumulus: small lumpy cloudlets high up.
-    Altocumulus,
-    /// Altostratus: a thin, wispy high sheet.
-    Altostratus,
-    /// Nimbostratus: a thick, dark, blurry deck.
-    Nimbostratus,
-}
+use crate::scene::CloudType;
 
 /// Every type, in declaration order.
 pub const ALL_TYPES: [CloudType; 10] = [

@@ -229,6 +229,10 @@ pub fn sector_elevations(
     (lo - margin, hi + margin)
 }
 
+/// What the sprite passes share (`sprite.wgsl`).
+pub static SPRITE_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("sprite", "sprite.wgsl", [&crate::frame::FRAME_WGSL]);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -237,7 +241,7 @@ mod tests {
     #[test]
     fn the_view_uniform_matches_its_wgsl_layout() {
         assert_wgsl_layout!(
-            "sprite_render",
+            &crate::sprites::render::SPRITE_RENDER_WGSL,
             "View",
             ViewUniform {
                 clip_from_world,

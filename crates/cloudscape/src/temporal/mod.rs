@@ -4,13 +4,11 @@
 //! upsamples them with depth awareness, reprojects the history at the cloud distance, clips it to
 //! the neighbourhood and blends. It reads only the cloud output ([`crate::output`]).
 
-use crate::frame::{Frame, Shared, SharedSlots};
-use crate::gpu::pipeline::{
-    BindGroupCache, UNFILTERABLE_TEXTURE_2D, UNIFORM, bind_group, bind_group_layout,
-    compute_pipeline, dispatch_2d, float_texture, storage_texture_2d, uniform_buffer,
-};
+use crate::frame::Frame;
+use crate::gpu::pipeline::{dispatch_2d, uniform_buffer};
 use crate::gpu::{GpuContext, PassTimer};
-use crate::output::{CLOUD_DISTANCE_FORMAT, CLOUD_FORMAT, CloudOutput, SampleGrid};
+use crate::output::{CloudOutput, SampleGrid};
+use crate::pass::{BindGroupCache, ComputePass, Shared};
 use crate::scene::knobs::Allowed::Between;
 use crate::scene::knobs::{Knob, knob};
 use bytemuck::{Pod, Zeroable};
@@ -126,10 +124,8 @@ struct PreviousFrame {
 /// The temporal resolve pass and its two full-resolution histories (ping-pong), each with the
 /// cloud distance its pixels show.
 pub struct TemporalResolve {
-    slots: SharedSlots,
+    pass: ComputePass,
     settings: TemporalSettings,
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
     sampler: wgpu::Sampler,
     history: Option<[CloudOutput; 2]>,
@@ -141,38 +137,20 @@ pub struct TemporalResolve {
 impl TemporalResolve {
     /// Builds the pass against the shared groups' layouts.
     pub fn new(ctx: &GpuContext, shared: &Shared, settings: TemporalSettings) -> TemporalResolve {
-        use wgpu::TextureViewDimension::D2;
-        let unfilterable = UNFILTERABLE_TEXTURE_2D;
-        let sampler_type = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
-        let types = [
-            UNIFORM,
-            float_texture(D2),
-            unfilterable,
-            float_texture(D2),
-            sampler_type,
-            unfilterable,
-            storage_texture_2d(CLOUD_FORMAT),
-            unfilterable,
-            storage_texture_2d(CLOUD_DISTANCE_FORMAT),
-        ];
-        let layout = bind_group_layout(&ctx.device, "temporal resolve", &types);
-        let pipeline = compute_pipeline(
-            ctx,
-            "temporal resolve",
-            &crate::shader::program("temporal"),
-            "resolve_clouds",
-            &shared.layouts(SharedSlots::of("temporal"), &layout),
-        );
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
         TemporalResolve {
-            slots: SharedSlots::of("temporal"),
+            pass: ComputePass::new(
+                ctx,
+                shared,
+                "temporal resolve",
+                &TEMPORAL_WGSL,
+                &["resolve_clouds"],
+            ),
             settings,
-            pipeline,
-            layout,
             uniform: uniform_buffer(ctx, "temporal", size_of::<TemporalUniform>() as u64),
             sampler,
             history: None,
@@ -224,7 +202,7 @@ impl TemporalResolve {
         self.write_uniform(ctx, frame, wind_m_per_s);
         let (read, write) = (self.latest, 1 - self.latest);
         let history = self.history.as_ref().expect("ensure_history made it");
-        let (layout, uniform, sampler) = (&self.layout, &self.uniform, &self.sampler);
+        let (pass, uniform, sampler) = (&self.pass, &self.uniform, &self.sampler);
         let views = [
             &current.radiance,
             &current.distance,
@@ -236,19 +214,18 @@ impl TemporalResolve {
         ];
         let group = self.groups.get(&views, || {
             use wgpu::BindingResource::{Sampler, TextureView};
-            bind_group(
-                &ctx.device,
-                layout,
+            pass.group.bind(
+                ctx,
                 &[
-                    uniform.as_entire_binding(),
-                    TextureView(views[0]),
-                    TextureView(views[1]),
-                    TextureView(views[2]),
-                    Sampler(sampler),
-                    TextureView(views[3]),
-                    TextureView(views[4]),
-                    TextureView(views[5]),
-                    TextureView(views[6]),
+                    ("temporal", uniform.as_entire_binding()),
+                    ("coarse_clouds", TextureView(views[0])),
+                    ("coarse_distance", TextureView(views[1])),
+                    ("history_in", TextureView(views[2])),
+                    ("history_linear", Sampler(sampler)),
+                    ("temporal_host_depth", TextureView(views[3])),
+                    ("history_out", TextureView(views[4])),
+                    ("history_distance_in", TextureView(views[5])),
+                    ("history_distance_out", TextureView(views[6])),
                 ],
             )
         });
@@ -256,8 +233,8 @@ impl TemporalResolve {
         dispatch_2d(
             encoder,
             "temporal resolve",
-            &self.pipeline,
-            &shared.bind_groups(self.slots, group),
+            pass.main(),
+            &shared.bind_groups(pass.slots, group),
             frame.size,
             writes,
         );
@@ -304,6 +281,17 @@ impl TemporalResolve {
     }
 }
 
+/// Depth-aware upsampling of a coarse cloud output (`upsample.wgsl`), for every pass that reads one.
+pub static UPSAMPLE_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("upsample", "upsample.wgsl", [&crate::frame::FRAME_WGSL]);
+
+/// The temporal reconstruction pass (`temporal.wgsl`).
+pub static TEMPORAL_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "temporal",
+    "temporal.wgsl",
+    [&crate::frame::FRAME_WGSL, &UPSAMPLE_WGSL]
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -312,7 +300,7 @@ mod tests {
     #[test]
     fn temporal_uniform_matches_its_wgsl_layout() {
         assert_wgsl_layout!(
-            "temporal",
+            &crate::temporal::TEMPORAL_WGSL,
             "Temporal",
             TemporalUniform {
                 prev_clip_from_world,

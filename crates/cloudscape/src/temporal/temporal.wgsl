@@ -1,4 +1,3 @@
-#import frame upsample
 // Temporal reconstruction of undersampled clouds (volumecloud-implementation-detail): the current
 // coarse output upsampled with depth awareness, the history reprojected with the previous frame's
 // view-projection at the estimated cloud distance, clipped to the current neighbourhood and
@@ -17,7 +16,9 @@ struct Temporal {
 }
 
 @group(3) @binding(0) var<uniform> temporal: Temporal;
-// Bindings 1 and 2: this frame's coarse output (coarse_clouds, coarse_distance in upsample.wgsl).
+// The coarse output that upsample.wgsl reads.
+@group(3) @binding(1) var coarse_clouds: texture_2d<f32>;
+@group(3) @binding(2) var coarse_distance: texture_2d<f32>;
 @group(3) @binding(3) var history_in: texture_2d<f32>;
 @group(3) @binding(4) var history_linear: sampler;
 @group(3) @binding(5) var temporal_host_depth: texture_2d<f32>;

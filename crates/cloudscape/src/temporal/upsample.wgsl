@@ -1,13 +1,11 @@
-#import frame
 // Depth-aware upsampling of a coarse cloud output (Yusov 2014, bilateral upsampling): the shared
 // pass code that turns an output on a 1/divisor grid into full-resolution estimates, for any
 // technique.
 
-// The coarse cloud output a pass upsamples: bindings 1 and 2 of its own group (3), so that every
-// pass that reads a coarse output binds it alike. Globals, not function arguments: lavapipe crashes
-// on texture handles passed to functions.
-@group(3) @binding(1) var coarse_clouds: texture_2d<f32>;
-@group(3) @binding(2) var coarse_distance: texture_2d<f32>;
+// The coarse cloud output it upsamples, `coarse_clouds` (rgba16float) and `coarse_distance`
+// (r32float), are globals the importing pass declares in its own group: a library module binds
+// nothing in a pass's group. Globals, not function arguments: lavapipe crashes on texture handles
+// passed to functions.
 
 struct UpsampledCloud {
     radiance_transmittance: vec4<f32>,

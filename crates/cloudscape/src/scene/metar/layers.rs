@@ -7,7 +7,7 @@
 //!   ([`CloudGenus::of`]).
 //! - **Shape**: each genus is drawn with one of the field's four types and has a typical depth and
 //!   extinction ([`CloudGenus`]'s table). The layer's `thickness_m` is sized so that the type's
-//!   height profile ([`crate::field::profile::TYPE_GRADIENTS`], which fills only part of a layer)
+//!   height profile ([`TYPE_GRADIENTS`], which fills only part of a layer)
 //!   spans the genus' depth.
 //! - **Cover**: FEW, SCT and BKN get the layer `coverage` that makes the measured fraction of cloudy
 //!   columns of that genus land mid-okta (FEW 1.5/8, SCT 3.5/8, BKN 6/8); OVC gets coverage 1, a
@@ -21,8 +21,7 @@
 //!   are left out.
 
 use super::{CloudGroup, Convective, Cover, Report, SkyGroup, Visibility, Wind};
-use crate::field::profile::TYPE_GRADIENTS;
-use crate::scene::{CloudLayer, CloudTypeMix};
+use crate::scene::{CloudLayer, CloudTypeMix, TYPE_GRADIENTS};
 
 /// What a report sets in a scene.
 #[derive(Clone, Debug, PartialEq)]

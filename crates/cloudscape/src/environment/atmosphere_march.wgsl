@@ -1,4 +1,3 @@
-#import constants atmosphere environment phase
 // The integral of the air's scattered light along a ray (Hillaire 2020 eq. 1-4), shared by the
 // table passes.
 

@@ -1,16 +1,16 @@
 //! The atmosphere's table passes: transmittance, multiple scattering and irradiance once per air,
 //! the sky view and the aerial perspective every frame (Hillaire 2020). They fill the tables that
-//! [`crate::environment::EnvironmentGpu`] binds.
+//! [`super::EnvironmentGpu`] binds.
 
-use super::Air;
-use super::luts::{
+use super::{EnvironmentGpu, EnvironmentTable, TablePass};
+use crate::atmosphere::ATMOSPHERE_WGSL;
+use crate::atmosphere::Air;
+use crate::atmosphere::luts::{
     AERIAL_SIZE, IRRADIANCE_SIZE, MULTIPLE_SCATTERING_SIZE, SKY_VIEW_SIZE, TRANSMITTANCE_SIZE,
 };
-use crate::environment::{EnvironmentTable, TablePass};
-use crate::frame::Shared;
 use crate::gpu::{GpuContext, PassTimer};
+use crate::pass::Shared;
 use glam::UVec2;
-use wgpu::TextureViewDimension::D2;
 
 /// Labels of the passes that run when the air changes, in order.
 pub const TABLE_PASS_NAMES: [&str; 3] = [
@@ -38,14 +38,8 @@ pub struct AtmospherePasses {
 impl AtmospherePasses {
     /// Builds the pipelines against the shared groups.
     pub fn new(ctx: &GpuContext, shared: &Shared) -> AtmospherePasses {
-        let luts = |entry, label, table, outputs: &[wgpu::TextureViewDimension]| {
-            TablePass::new(
-                ctx,
-                shared,
-                ("atmosphere_luts", entry),
-                (label, table),
-                outputs,
-            )
+        let luts = |entry, label, table| {
+            TablePass::new(ctx, shared, (&ATMOSPHERE_LUTS_WGSL, entry), (label, table))
         };
         let [t, ms, irr] = TABLE_PASS_NAMES;
         let [view, aerial] = FRAME_PASS_NAMES;
@@ -54,32 +48,23 @@ impl AtmospherePasses {
                 "atmosphere_build_transmittance",
                 t,
                 EnvironmentTable::Transmittance,
-                &[D2],
             ),
             multiple_scattering: luts(
                 "atmosphere_build_multiple_scattering",
                 ms,
                 EnvironmentTable::MultipleScattering,
-                &[D2],
             ),
             irradiance: luts(
                 "atmosphere_build_irradiance",
                 irr,
                 EnvironmentTable::Irradiance,
-                &[D2, D2],
             ),
-            sky_view: luts(
-                "atmosphere_build_sky_view",
-                view,
-                EnvironmentTable::SkyView,
-                &[D2],
-            ),
+            sky_view: luts("atmosphere_build_sky_view", view, EnvironmentTable::SkyView),
             aerial: TablePass::new(
                 ctx,
                 shared,
-                ("atmosphere_aerial", "atmosphere_build_aerial"),
+                (&ATMOSPHERE_AERIAL_WGSL, "atmosphere_build_aerial"),
                 (aerial, EnvironmentTable::Aerial),
-                &[D2, D2],
             ),
             filled_for: None,
         }
@@ -91,11 +76,11 @@ impl AtmospherePasses {
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        shared: &Shared,
+        (shared, environment): (&Shared, &EnvironmentGpu),
         air: &Air,
         mut timer: Option<&mut PassTimer>,
     ) {
-        let key = (*air, shared.environment.generation());
+        let key = (*air, environment.generation());
         if self.filled_for != Some(key) {
             let statics = [
                 (&mut self.transmittance, TRANSMITTANCE_SIZE),
@@ -103,14 +88,57 @@ impl AtmospherePasses {
                 (&mut self.irradiance, IRRADIANCE_SIZE),
             ];
             for (pass, texels) in statics {
-                pass.encode(ctx, encoder, shared, size(texels), timer.as_deref_mut());
+                pass.encode(
+                    ctx,
+                    encoder,
+                    (shared, environment),
+                    size(texels),
+                    timer.as_deref_mut(),
+                );
             }
             self.filled_for = Some(key);
         }
         let view = size(SKY_VIEW_SIZE);
+        let groups = (shared, environment);
         self.sky_view
-            .encode(ctx, encoder, shared, view, timer.as_deref_mut());
+            .encode(ctx, encoder, groups, view, timer.as_deref_mut());
         self.aerial
-            .encode(ctx, encoder, shared, size(AERIAL_SIZE), timer);
+            .encode(ctx, encoder, groups, size(AERIAL_SIZE), timer);
     }
 }
+
+/// Marches through the air that the table passes share (`atmosphere_march.wgsl`).
+pub static ATMOSPHERE_MARCH_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "atmosphere_march",
+    "atmosphere_march.wgsl",
+    [
+        &crate::shader::MATH_WGSL,
+        &ATMOSPHERE_WGSL,
+        &super::ENVIRONMENT_WGSL,
+        &crate::optics::phase::PHASE_WGSL
+    ]
+);
+
+/// The passes that fill the atmosphere's tables (`atmosphere_luts.wgsl`).
+pub static ATMOSPHERE_LUTS_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "atmosphere_luts",
+    "atmosphere_luts.wgsl",
+    [
+        &crate::shader::MATH_WGSL,
+        &ATMOSPHERE_WGSL,
+        &super::ENVIRONMENT_WGSL,
+        &ATMOSPHERE_MARCH_WGSL
+    ]
+);
+
+/// The pass that fills the aerial-perspective volume (`atmosphere_aerial.wgsl`).
+pub static ATMOSPHERE_AERIAL_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "atmosphere_aerial",
+    "atmosphere_aerial.wgsl",
+    [
+        &crate::frame::FRAME_WGSL,
+        &ATMOSPHERE_WGSL,
+        &super::ENVIRONMENT_WGSL,
+        &ATMOSPHERE_MARCH_WGSL
+    ]
+);

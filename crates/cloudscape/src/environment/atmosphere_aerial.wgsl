@@ -1,4 +1,3 @@
-#import constants frame atmosphere environment atmosphere_march
 // The aerial-perspective volume (Hillaire 2020): for each of 32 x 32 directions across the view
 // and each of 32 slices of 4 km, the light the air scatters toward the eye over the first
 // (slice + 1) x 4 km and the transmittance over them, with the sun's single scattering dimmed by

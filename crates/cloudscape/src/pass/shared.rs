@@ -1,9 +1,15 @@
 //! The bind groups every pass shares: the field, the frame and the environment, at the slots of
 //! [`crate::shader`].
 
-use super::FrameGpu;
-use crate::environment::EnvironmentGpu;
-use crate::field::gpu::FieldGpu;
+use crate::shader::Program;
+
+/// A bind group that passes share at a fixed slot: its layout and its group.
+pub trait SharedGroup {
+    /// The group's layout.
+    fn layout(&self) -> &wgpu::BindGroupLayout;
+    /// The group.
+    fn bind_group(&self) -> &wgpu::BindGroup;
+}
 
 /// Which shared groups a program uses: a pass binds only those (an unused slot stays empty).
 /// Binding no more than a program reads is also what lavapipe needs: it crashes when a compute pass
@@ -14,11 +20,15 @@ pub struct SharedSlots {
 }
 
 impl SharedSlots {
-    /// The shared groups program `root` ([`crate::shader::program`]) reaches.
-    pub fn of(root: &str) -> SharedSlots {
-        let modules = crate::shader::reached(root);
+    /// No shared group.
+    pub const NONE: SharedSlots = SharedSlots { used: [false; 3] };
+
+    /// The shared groups `program` binds: those its modules declare bindings in (each library
+    /// module binds only its own group, [`crate::shader`]).
+    pub fn of(program: &Program) -> SharedSlots {
+        let groups = program.groups();
         SharedSlots {
-            used: ["field", "frame", "environment"].map(|m| modules.contains(&m)),
+            used: std::array::from_fn(|slot| groups.contains(&(slot as u32))),
         }
     }
 }
@@ -26,17 +36,16 @@ impl SharedSlots {
 /// The field, frame and environment groups of one frame, borrowed for encoding.
 #[derive(Clone, Copy)]
 pub struct Shared<'a> {
-    /// The cloud field (group 0).
-    pub field: &'a FieldGpu,
+    /// The cloud field (group 0, [`crate::shader::FIELD_GROUP`]).
+    pub field: &'a dyn SharedGroup,
     /// The frame (group 1).
-    pub frame: &'a FrameGpu,
+    pub frame: &'a dyn SharedGroup,
     /// The environment (group 2).
-    pub environment: &'a EnvironmentGpu,
+    pub environment: &'a dyn SharedGroup,
 }
 
 impl<'a> Shared<'a> {
-    /// Pipeline layouts: the shared groups `slots` names, then the pass's own at
-    /// [`crate::shader::PASS_GROUP`].
+    /// Pipeline layouts: the shared groups `slots` names, then the pass's own at [`crate::shader::PASS_GROUP`].
     pub fn layouts(
         &self,
         slots: SharedSlots,
@@ -62,7 +71,7 @@ impl<'a> Shared<'a> {
 
     /// [`Shared::bind_groups`] for a pass that writes one of the environment's tables: with
     /// `environment`, the group that holds a stand-in for it
-    /// ([`EnvironmentGpu::bind_group_writing`]).
+    /// ([`crate::environment::EnvironmentGpu::bind_group_writing`]).
     pub fn bind_groups_with(
         &self,
         slots: SharedSlots,

@@ -1,8 +1,8 @@
 //! The cloud shadow map's pass: every texel's two columns through the coarse field, each frame.
 
-use crate::environment::{EnvironmentTable, TablePass};
-use crate::frame::Shared;
+use super::{EnvironmentGpu, EnvironmentTable, TablePass};
 use crate::gpu::{GpuContext, PassTimer};
+use crate::pass::Shared;
 use glam::UVec2;
 
 /// Label the pass is timed under.
@@ -16,14 +16,12 @@ pub struct CloudShadowPass {
 impl CloudShadowPass {
     /// Builds the pipeline against the shared groups.
     pub fn new(ctx: &GpuContext, shared: &Shared) -> CloudShadowPass {
-        let d2 = wgpu::TextureViewDimension::D2;
         CloudShadowPass {
             pass: TablePass::new(
                 ctx,
                 shared,
-                ("cloud_shadow", "shadow_build"),
+                (&CLOUD_SHADOW_WGSL, "shadow_build"),
                 (SHADOW_PASS_NAME, EnvironmentTable::CloudShadow),
-                &[d2, d2],
             ),
         }
     }
@@ -33,10 +31,21 @@ impl CloudShadowPass {
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        shared: &Shared,
+        groups: (&Shared, &EnvironmentGpu),
         timer: Option<&mut PassTimer>,
     ) {
-        let texels = UVec2::splat(shared.environment.shadow_texels());
-        self.pass.encode(ctx, encoder, shared, texels, timer);
+        let texels = UVec2::splat(groups.1.shadow_texels());
+        self.pass.encode(ctx, encoder, groups, texels, timer);
     }
 }
+
+/// The pass that renders the clouds' shadow map (`cloud_shadow.wgsl`).
+pub static CLOUD_SHADOW_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "cloud_shadow",
+    "cloud_shadow.wgsl",
+    [
+        &crate::shader::MATH_WGSL,
+        &crate::field::gpu::FIELD_WGSL,
+        &super::ENVIRONMENT_WGSL
+    ]
+);

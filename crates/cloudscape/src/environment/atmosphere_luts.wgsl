@@ -1,4 +1,3 @@
-#import constants atmosphere environment atmosphere_march
 // Building Hillaire 2020's tables, one texel per invocation into the pass's output (group 3,
 // binding 0). Each entry point is the twin of the SkyTables function named beside it. The tables
 // are read through environment.wgsl, whose group binds a stand-in for the table being written.

@@ -1,11 +1,35 @@
-//! The sun's place on the sky from local solar time, latitude and day of the year.
+//! Directions on the sky: the scene's elevation and azimuth as a vector, and the sun's place from
+//! local solar time, latitude and day of the year.
 
 use std::f32::consts::TAU;
 
 use glam::Vec3;
 
-use super::sun::{SunAngles, angles_of};
-use crate::scene::TimeOfDay;
+use super::{Sun, SunKey, TimeOfDay};
+
+/// Unit vector toward elevation `el` and azimuth `az` (degrees; azimuth clockwise from north, with
+/// x east, y up, z south): `(sin az cos el, sin el, -cos az cos el)`.
+pub fn direction_from_angles_deg(elevation_deg: f32, azimuth_deg: f32) -> Vec3 {
+    let (el, az) = (elevation_deg.to_radians(), azimuth_deg.to_radians());
+    Vec3::new(az.sin() * el.cos(), el.sin(), -az.cos() * el.cos())
+}
+
+/// The sun's place on the sky.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SunAngles {
+    /// Elevation above the horizon, degrees, -90..90.
+    pub elevation_deg: f32,
+    /// Azimuth, degrees clockwise from north, 0..360.
+    pub azimuth_deg: f32,
+}
+
+impl SunAngles {
+    /// Sets `sun`'s elevation and azimuth to these (its irradiance and colour are left as they are).
+    pub fn apply_to(&self, sun: &mut Sun) {
+        sun.elevation_deg = self.elevation_deg;
+        sun.azimuth_deg = self.azimuth_deg;
+    }
+}
 
 /// Solar declination in radians on `day_of_year` (1 = 1 January), by Spencer's Fourier series
 /// (J. W. Spencer 1971, "Fourier series representation of the position of the sun", Search 2(5),
@@ -41,6 +65,32 @@ pub fn solar_position(time: &TimeOfDay) -> SunAngles {
     angles_of(solar_direction(time))
 }
 
+/// The direction toward the sun a keyframe gives: its angles, or its solar time on the latitude
+/// and day of `day`; `None` when it has neither (or solar time but no `day`).
+pub fn key_direction(key: &SunKey, day: Option<&TimeOfDay>) -> Option<Vec3> {
+    if let (Some(elevation_deg), Some(azimuth_deg)) = (key.sun_elevation_deg, key.sun_azimuth_deg) {
+        return Some(direction_from_angles_deg(elevation_deg, azimuth_deg));
+    }
+    let time = TimeOfDay {
+        solar_time_h: key.solar_time_h?,
+        ..day?.clone()
+    };
+    Some(solar_direction(&time))
+}
+
+/// Elevation and azimuth of the unit vector `direction`; the inverse of
+/// [`direction_from_angles_deg`] (azimuth 0 straight up or down).
+pub(crate) fn angles_of(direction: Vec3) -> SunAngles {
+    SunAngles {
+        elevation_deg: direction.y.clamp(-1.0, 1.0).asin().to_degrees(),
+        azimuth_deg: direction
+            .x
+            .atan2(-direction.z)
+            .to_degrees()
+            .rem_euclid(360.0),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -56,6 +106,19 @@ mod tests {
             latitude_deg,
             day_of_year,
         })
+    }
+
+    #[test]
+    fn angles_follow_the_compass() {
+        assert!(
+            direction_from_angles_deg(0.0, 0.0).abs_diff_eq(Vec3::NEG_Z, 1e-6),
+            "north is -z"
+        );
+        assert!(
+            direction_from_angles_deg(0.0, 90.0).abs_diff_eq(Vec3::X, 1e-6),
+            "east is +x"
+        );
+        assert!(direction_from_angles_deg(90.0, 0.0).abs_diff_eq(Vec3::Y, 1e-6));
     }
 
     #[test]

@@ -1,4 +1,3 @@
-#import constants field environment
 // Builds the clouds' shared light-space map (shadow/mod.rs): per texel, the coarse optical depth
 // from four checkpoint heights to the top of the clouds, along the sun (layer 0, binding 0) and
 // straight up (layer 1, binding 1). ShadowParams::column.
