@@ -5,12 +5,7 @@
 //!
 //! `cargo run -p cloudscape --example host -- [OUT.png]`
 
-use cloudscape::frame::{DepthConvention, Frame, FrameSun};
-use cloudscape::gpu::{GpuContext, read_texture, read_texture_rgba16f};
-use cloudscape::image::LdrImage;
-use cloudscape::post::Background;
-use cloudscape::renderer::{CloudRenderer, Reuse};
-use cloudscape::scene::{SceneDocument, direction_from_angles_deg};
+use cloudscape::prelude::*;
 use glam::{UVec2, Vec3};
 use wgpu::util::DeviceExt;
 
@@ -113,7 +108,20 @@ impl HostTargets {
     fn new(gpu: &GpuContext) -> HostTargets {
         use wgpu::TextureUsages as U;
         let texture = |label, format, usage| {
-            cloudscape::gpu::pipeline::texture_2d(gpu, label, SIZE, format, usage)
+            gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: SIZE.x,
+                    height: SIZE.y,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
         };
         let color = texture(
             "host colour",

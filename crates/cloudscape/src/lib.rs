@@ -5,7 +5,15 @@
 //! the field into the cloud-output contract ([`output`]) through the [`technique::Technique`]
 //! trait; the shared frame state ([`frame`], [`environment`]) and the shared passes ([`temporal`],
 //! [`post`]) serve every technique. [`renderer::CloudRenderer`] hosts them on a game engine's
-//! device; [`renderer::SceneRenderer`] renders whole scenes offline.
+//! device; [`renderer::SceneRenderer`] renders whole scenes offline. A host needs only
+//! [`prelude`].
+//!
+//! The top-level modules form a DAG (`tests/module_graph.rs` holds them to it), from the leaves up:
+//! the WGSL registry ([`shader`]), GPU helpers ([`gpu`]), images and optics; the scene document
+//! ([`scene`]); the field ([`field`]), the frame ([`frame`]), the atmosphere and the environment
+//! ([`environment`]); the pass builder and shared groups (`pass`, internal); the techniques
+//! ([`raymarch`], [`particles`], [`sprites`]) behind [`technique`]; temporal reuse, composition and
+//! the hosts ([`renderer`]).
 //!
 //! Cargo features, all off by default (without them the crate builds no C or C++ and no image
 //! codec): `png` (PNG files of [`image::LdrImage`], weather maps from PNG files), `exr` (OpenEXR
@@ -14,7 +22,7 @@
 //! build for a file type it lacks is an error that names the feature.
 
 pub mod animation;
-pub mod atmosphere;
+pub(crate) mod atmosphere;
 pub mod environment;
 pub mod export;
 pub mod field;
@@ -25,8 +33,9 @@ pub mod image;
 pub mod optics;
 pub mod output;
 pub mod particles;
-pub mod pass;
+pub(crate) mod pass;
 pub mod post;
+pub mod prelude;
 pub mod probe;
 pub mod raymarch;
 pub mod renderer;

@@ -31,3 +31,20 @@ fn the_readme_shows_the_example_host() {
         );
     }
 }
+
+#[test]
+fn the_example_host_uses_only_the_prelude() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let example = std::fs::read_to_string(dir.join("examples/host.rs")).expect("examples/host.rs");
+    let paths: Vec<&str> = example
+        .match_indices("cloudscape::")
+        .map(|(at, _)| &example[at..(at + 30).min(example.len())])
+        .collect();
+    assert!(!paths.is_empty(), "the example uses the library");
+    for path in paths {
+        assert!(
+            path.starts_with("cloudscape::prelude::"),
+            "the example reaches past the prelude: {path}"
+        );
+    }
+}

@@ -85,3 +85,16 @@ fn every_wgsl_file_is_a_module_some_program_reaches() {
         "every .wgsl file, and only those, is reached"
     );
 }
+
+#[test]
+fn a_host_shader_reaches_the_cloud_shadow() {
+    let host = "@fragment fn host_fs(@location(0) p: vec3<f32>) -> @location(0) vec4<f32> {\n\
+            return vec4<f32>(vec3<f32>(environment_cloud_sun_transmittance(p)), 1.0);\n\
+        }\n";
+    let program = Program::host(&[&ENVIRONMENT_WGSL], host);
+    assert!(program.reaches(&ENVIRONMENT_WGSL));
+    program.validate().unwrap_or_else(|e| panic!("{e}"));
+    let broken = Program::host(&[&ENVIRONMENT_WGSL], "fn f() -> f32 { return nope; }\n");
+    let error = broken.validate().expect_err("nope is undefined");
+    assert!(error.to_string().starts_with("host source:1:"), "{error}");
+}

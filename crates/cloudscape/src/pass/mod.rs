@@ -51,11 +51,6 @@ impl PassGroup {
         }
     }
 
-    /// The group's layout.
-    pub fn layout(&self) -> &wgpu::BindGroupLayout {
-        &self.layout
-    }
-
     /// A bind group holding `resources`, each named as its WGSL global.
     ///
     /// # Panics
@@ -234,5 +229,35 @@ impl RasterPass {
             slots,
             pipeline,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    static PROBED: WgslModule = WgslModule {
+        name: "probed",
+        declared_in: file!(),
+        file: "(test)",
+        source: "
+            @group(3) @binding(0) var<storage, read_write> values: array<f32>;
+            @compute @workgroup_size(1)
+            fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+                values[id.x] = 1.0;
+            }
+        ",
+        imports: &[],
+        constants: None,
+    };
+
+    #[test]
+    #[should_panic(expected = "not bound by Rust: [\"values\"]; not declared in WGSL: [\"value\"]")]
+    fn a_resource_named_unlike_its_wgsl_global_is_refused() {
+        let ctx = GpuContext::for_tests();
+        let pass = ComputePass::standalone(&ctx, "probed", &PROBED, &["main"]);
+        let buffer = crate::gpu::pipeline::storage_buffer(&ctx, "values", 16);
+        pass.group
+            .bind(&ctx, &[("value", buffer.as_entire_binding())]);
     }
 }

@@ -198,3 +198,79 @@ fn storage_format(format: naga::StorageFormat) -> wgpu::TextureFormat {
         other => panic!("storage format {other:?} is not supported in a pass group"),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shader::WgslModule;
+
+    static REFLECTED: WgslModule = WgslModule {
+        name: "reflected",
+        declared_in: file!(),
+        file: "(test)",
+        source: "
+            @group(3) @binding(0) var<uniform> settings: vec4<f32>;
+            @group(3) @binding(1) var<storage, read> inputs: array<f32>;
+            @group(3) @binding(2) var<storage, read_write> outputs: array<f32>;
+            @group(3) @binding(3) var loaded: texture_2d<f32>;
+            @group(3) @binding(4) var sampled: texture_3d<f32>;
+            @group(3) @binding(5) var linear: sampler;
+            @group(3) @binding(6) var written: texture_storage_2d<r32float, write>;
+            @group(3) @binding(7) var<storage, read> unused_here: array<f32>;
+            @compute @workgroup_size(1)
+            fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+                let s = textureSampleLevel(sampled, linear, vec3<f32>(0.5), 0.0).x;
+                let l = textureLoad(loaded, vec2<i32>(0), 0).x;
+                outputs[id.x] = inputs[id.x] * settings.x + s + l;
+                textureStore(written, vec2<i32>(id.xy), vec4<f32>(s));
+            }
+        ",
+        imports: &[],
+        constants: None,
+    };
+
+    #[test]
+    fn a_pass_layout_follows_its_wgsl() {
+        use wgpu::BindingType as B;
+        let bindings = reflect(&Program::new(&REFLECTED), &["main"]);
+        let names: Vec<&str> = bindings.iter().map(|b| b.name.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "settings", "inputs", "outputs", "loaded", "sampled", "linear", "written"
+            ],
+            "bindings the entry point does not use are left out"
+        );
+        let ty = |i: usize| bindings[i].entry.ty;
+        assert!(matches!(
+            ty(0),
+            B::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                ..
+            }
+        ));
+        let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
+        assert!(matches!(ty(1), B::Buffer { ty, .. } if ty == storage(true)));
+        assert!(matches!(ty(2), B::Buffer { ty, .. } if ty == storage(false)));
+        let float = |filterable| wgpu::TextureSampleType::Float { filterable };
+        assert!(matches!(ty(3), B::Texture { sample_type, .. } if sample_type == float(false)));
+        assert!(matches!(
+            ty(4),
+            B::Texture { sample_type, view_dimension: wgpu::TextureViewDimension::D3, .. }
+                if sample_type == float(true)
+        ));
+        assert_eq!(ty(5), B::Sampler(wgpu::SamplerBindingType::Filtering));
+        assert!(matches!(
+            ty(6),
+            B::StorageTexture {
+                format: wgpu::TextureFormat::R32Float,
+                ..
+            }
+        ));
+        assert!(
+            bindings
+                .iter()
+                .all(|b| b.entry.visibility == wgpu::ShaderStages::COMPUTE)
+        );
+    }
+}

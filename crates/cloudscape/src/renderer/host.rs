@@ -247,6 +247,16 @@ impl CloudRenderer {
         &self.field
     }
 
+    /// The environment's bind group and its layout, for a host's own shaders built with
+    /// [`crate::shader::Program::host`] over [`crate::environment::ENVIRONMENT_WGSL`] (the sky, the
+    /// sun, the clouds' shadow on its geometry): bind it at [`crate::shader::ENVIRONMENT_GROUP`].
+    pub fn environment_group(&self) -> (&wgpu::BindGroupLayout, &wgpu::BindGroup) {
+        (
+            self.environment_gpu.layout(),
+            self.environment_gpu.bind_group(),
+        )
+    }
+
     /// The shared groups, for passes a host adds (probes, its own effects).
     pub fn shared(&self) -> Shared<'_> {
         Shared {
