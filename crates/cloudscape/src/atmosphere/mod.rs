@@ -8,9 +8,9 @@
 //! tables the GPU builds (`atmosphere.wgsl`, [`gpu::AtmosphereTables`]) and the path tracer lights
 //! with it; tests hold each GPU table to it.
 
-pub mod luts;
-pub mod medium;
-pub mod table;
+pub(crate) mod luts;
+pub(crate) mod medium;
+pub(crate) mod table;
 mod wgsl;
 
 pub use medium::Air;

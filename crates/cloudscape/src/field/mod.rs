@@ -10,7 +10,7 @@ pub mod hiheight;
 mod layer;
 pub mod noise;
 pub mod profile;
-pub mod texture;
+pub(crate) mod texture;
 mod vol_file;
 pub mod voxel;
 pub mod weather;

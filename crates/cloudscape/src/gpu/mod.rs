@@ -7,19 +7,19 @@
 //! - [`test_gpu`]: the device GPU tests share, taken in turns on OpenGL.
 //! - [`pipeline`]: compute and raster pipeline builders; [`uniform`]: a uniform in its own group.
 
-pub mod context;
-pub mod memory;
+pub(crate) mod context;
+pub(crate) mod memory;
 pub mod readback;
-pub mod test_gpu;
-pub mod timing;
+pub(crate) mod test_gpu;
+pub(crate) mod timing;
 
 pub use context::{Backend, GpuContext, GpuError, GpuOptions};
 pub use memory::GpuMemoryReport;
 pub use readback::{read_buffer, read_texture, read_texture_rgba16f, read_texture_rgba32f};
 pub use test_gpu::{TEST_BACKEND_ENV, TestGpu};
 pub use timing::PassTimer;
-pub mod late_readback;
+pub(crate) mod late_readback;
 #[cfg(test)]
 pub(crate) mod layout_check;
 pub mod pipeline;
-pub mod uniform;
+pub(crate) mod uniform;

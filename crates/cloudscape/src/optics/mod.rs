@@ -3,9 +3,9 @@
 //!
 //! Each CPU formula has a WGSL twin in `phase.wgsl` (the `phase` shader module).
 
-pub mod phase;
-pub mod slab;
-pub mod step;
+pub(crate) mod phase;
+pub(crate) mod slab;
+pub(crate) mod step;
 
 pub use phase::{Octaves, PhaseLobes, draine, henyey_greenstein};
 pub use slab::SunSlab;

@@ -16,14 +16,14 @@ pub mod density;
 pub mod generate;
 pub mod generate_gpu;
 pub mod gpu;
-pub mod grid;
+pub(crate) mod grid;
 pub mod optical_depth;
 pub mod preview;
 pub mod render;
 pub mod scattering;
 pub mod store;
 pub mod table_file;
-pub mod tables_gpu;
+pub(crate) mod tables_gpu;
 
 use crate::optics::PhaseLobes;
 use crate::scene::{Scene, TableResolution};

@@ -4,7 +4,7 @@
 //! made once; bind groups are remade only when the targets change.
 
 pub mod tonemap;
-pub mod upsample;
+pub(crate) mod upsample;
 
 use crate::gpu::pipeline::{dispatch_2d, uniform_buffer};
 use crate::gpu::{GpuContext, PassTimer};

@@ -13,14 +13,14 @@
 
 pub mod cloud_set;
 pub mod file;
-pub mod from_field;
+pub(crate) mod from_field;
 pub mod impostors;
-pub mod model;
-pub mod render;
+pub(crate) mod model;
+pub(crate) mod render;
 pub mod shading;
-pub mod textures;
+pub(crate) mod textures;
 pub mod types;
-pub mod views;
+pub(crate) mod views;
 
 pub use file::ModelFile;
 pub use model::{CloudModel, Sprite, SpriteBox, SpriteCloud};

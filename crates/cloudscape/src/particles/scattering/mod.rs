@@ -15,9 +15,9 @@
 //! scattering, orders 2 and up, in sr^-1 (`L_ms = E M`), from [`orders::multiple_scattering`].
 //! Run time: `L = E (p(mu) S + M)` per light.
 
-pub mod directions;
-pub mod medium;
-pub mod orders;
+pub(crate) mod directions;
+pub(crate) mod medium;
+pub(crate) mod orders;
 
 use glam::{UVec3, Vec3};
 use rayon::prelude::*;
