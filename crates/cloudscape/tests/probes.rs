@@ -280,6 +280,48 @@ fn analytic_environment_functions_match_the_cpu() {
         disagree <= 2,
         "{disagree} sun-disc radiances differ from SunDisc::radiance"
     );
+    // The anti-aliased disc: pixels of several sizes around the sun, the GPU against the CPU.
+    let radius = sun.cos_radius.acos();
+    let e1 = sun.direction.any_orthonormal_vector();
+    let e2 = sun.direction.cross(e1);
+    let pixels: Vec<(Vec3, Vec3, Vec3)> = (0..240)
+        .map(|i| {
+            let size = radius * [0.3, 1.1, 2.7][i % 3];
+            let at = Vec2::new((i % 16) as f32 - 7.6, (i / 16) as f32 - 7.3) * radius * 0.35;
+            let dir = (sun.direction + e1 * at.x + e2 * at.y).normalize();
+            (dir, e1 * size, e2 * size)
+        })
+        .collect();
+    let pixel_inputs: Vec<ProbeInput> = pixels
+        .iter()
+        .map(|(d, x, y)| ProbeInput {
+            a: d.extend(0.0),
+            b: x.extend(0.0),
+            c: y.extend(0.0),
+            d: Vec4::ZERO,
+        })
+        .collect();
+    let got = gpu(
+        &ctx,
+        &clouds,
+        ProbeFunction::SunDiscPixelRadiance,
+        &pixel_inputs,
+    );
+    let want: Vec<Vec4> = pixels
+        .iter()
+        .map(|(d, x, y)| env.sun_disc_pixel_radiance(*d, *x, *y).extend(0.0))
+        .collect();
+    assert!(
+        want.iter().filter(|w| w.x > 0.0).count() > 40,
+        "pixels see the disc"
+    );
+    let peak = want.iter().map(|w| w.max_element()).fold(0.0, f32::max);
+    for (g, w) in got.iter().zip(&want) {
+        assert!(
+            (*g - *w).abs().max_element() <= 2e-3 * peak,
+            "pixel sun radiance: GPU {g} vs CPU {w}"
+        );
+    }
     let sky = gpu(&ctx, &clouds, ProbeFunction::SkyRadiance, &inputs);
     let want: Vec<Vec4> = dirs
         .iter()

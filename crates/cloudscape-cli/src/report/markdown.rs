@@ -46,8 +46,9 @@ fn introduction(s: &mut String, args: &ReportArgs, adapter: &str) {
          tracer applies the air between the eye and the first scattering or ground hit, the \
          real-time techniques at the cloud distance, and only theirs is shadowed by the clouds. \
          Where the sun is in frame its disc (radiance about 10^5) dominates the mean luminance: \
-         the path tracer spreads it over its pixel, the ray marcher draws it only where a pixel \
-         centre falls inside; HDR-FLIP is the robust number. Frame times are the wall time of a \
+         both renderers spread it over the pixels it covers (the path tracer by sampling each \
+         pixel's footprint, the real-time compositor by the disc's exact mean over the pixel); \
+         HDR-FLIP is the robust number. Frame times are the wall time of a \
          whole warm frame on the adapter above (on a software adapter, CPU time: compare them \
          with each other, not with a GPU's).\n",
         w = args.width,

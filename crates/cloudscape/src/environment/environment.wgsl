@@ -111,6 +111,44 @@ fn environment_sun_disc_radiance(d: vec3<f32>) -> vec3<f32> {
     return environment_sun_irradiance(environment.viewpoint_m) * limb / (2.0 * PI * one_minus_cos_radius);
 }
 
+// Mean radiance of the sun's disc over the pixel around direction d whose sides are step_x and
+// step_y (the steps to the neighbouring pixel centres): closed form along x, SUN_PIXEL_ROWS
+// midpoint rows in phi (y = r sin phi) across: SunDisc::pixel_radiance_of.
+fn environment_sun_disc_pixel_radiance(d: vec3<f32>, step_x: vec3<f32>, step_y: vec3<f32>) -> vec3<f32> {
+    let radius = acos(clamp(environment.sun_cos_angular_radius, -1.0, 1.0));
+    let half = vec2<f32>(length(step_x), length(step_y)) * 0.5;
+    let from_sun = d - environment.sun_direction;
+    if radius <= 0.0 || min(half.x, half.y) <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let centre = vec2<f32>(dot(from_sun, step_x) / (2.0 * half.x), dot(from_sun, step_y) / (2.0 * half.y));
+    let lo = centre - half;
+    let hi = centre + half;
+    let phi_lo = asin(clamp(lo.y / radius, -1.0, 1.0));
+    let phi_hi = asin(clamp(hi.y / radius, -1.0, 1.0));
+    if phi_hi <= phi_lo || lo.x >= radius || hi.x <= -radius {
+        return vec3<f32>(0.0);
+    }
+    let u = environment.sun_limb_darkening;
+    let dphi = (phi_hi - phi_lo) / f32(SUN_PIXEL_ROWS);
+    var sum = 0.0;
+    for (var k = 0u; k < SUN_PIXEL_ROWS; k++) {
+        let w = radius * cos(phi_lo + (f32(k) + 0.5) * dphi);
+        let a = clamp(lo.x, -w, w);
+        let b = clamp(hi.x, -w, w);
+        let row = (1.0 - u) * (b - a) + u / radius * (environment_disc_chord(b, w) - environment_disc_chord(a, w));
+        sum += row * w * dphi;
+    }
+    let omega = 2.0 * PI * (1.0 - environment.sun_cos_angular_radius);
+    let mean = sum / (1.0 - u / 3.0) / omega / (4.0 * half.x * half.y);
+    return environment_sun_irradiance(environment.viewpoint_m) * mean;
+}
+
+// int sqrt(w^2 - x^2) dx at x: (x sqrt(w^2 - x^2) + w^2 asin(x / w)) / 2.
+fn environment_disc_chord(x: f32, w: f32) -> f32 {
+    return 0.5 * (x * sqrt(max(w * w - x * x, 0.0)) + w * w * asin(clamp(x / w, -1.0, 1.0)));
+}
+
 // Sky radiance arriving at the viewpoint from direction d (the disc excluded): the sky-view table
 // (atmosphere) or SkyRadiance::radiance.
 fn environment_sky_radiance(d: vec3<f32>) -> vec3<f32> {

@@ -401,8 +401,17 @@ pub static ENVIRONMENT_WGSL: crate::shader::WgslModule = crate::shader::wgsl_mod
     [
         &crate::shader::MATH_WGSL,
         &crate::atmosphere::ATMOSPHERE_WGSL
-    ]
+    ],
+    environment_constants
 );
+
+/// The environment's constants as WGSL.
+fn environment_constants() -> String {
+    crate::shader::wgsl_consts([(
+        "SUN_PIXEL_ROWS",
+        crate::shader::WgslConst::U32(super::SUN_PIXEL_ROWS),
+    )])
+}
 
 impl crate::pass::SharedGroup for EnvironmentGpu {
     fn layout(&self) -> &wgpu::BindGroupLayout {

@@ -41,7 +41,7 @@ use crate::atmosphere::{Air, Atmosphere, SkyView};
 use crate::frame::FrameSun;
 use crate::scene::Scene;
 pub use crate::scene::SkyModel;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::f32::consts::{PI, TAU};
 use std::sync::Arc;
 
@@ -100,6 +100,9 @@ impl SkyRadiance {
     }
 }
 
+/// Rows of the midpoint rule across a pixel in [`SunDisc::pixel_radiance_of`].
+pub const SUN_PIXEL_ROWS: u32 = 16;
+
 /// The sun, a limb-darkened disc.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SunDisc {
@@ -134,6 +137,60 @@ impl SunDisc {
             .sqrt();
         let limb = (1.0 - u * (1.0 - mu)) / (1.0 - u / 3.0);
         irradiance * limb / (TAU * one_minus_cos_radius)
+    }
+
+    /// Mean of [`SunDisc::radiance_of`] over a pixel: the square of the sky around the pixel's
+    /// centre direction `dir` whose sides are `step_x` and `step_y`, the differences between the
+    /// directions through neighbouring pixel centres. An anti-aliased sun: a pixel shows the share
+    /// of the disc it covers, so the disc's flux over the image is its irradiance times the solid
+    /// angle it subtends, wherever it falls between pixel centres.
+    ///
+    /// In the plane tangent to the sky at the sun (angles of a few pixels), with `x`, `y` along the
+    /// pixel's sides and `rho^2 = x^2 + y^2`, the linear limb law integrates in closed form along
+    /// `x` over a chord of half-width `w = sqrt(r^2 - y^2)`:
+    /// `int (1 - u + u sqrt(w^2 - x^2) / r) dx`, with `int sqrt(w^2 - x^2) dx =
+    /// (x sqrt(w^2 - x^2) + w^2 asin(x / w)) / 2`; across `y = r sin(phi)` the
+    /// [`SUN_PIXEL_ROWS`]-point midpoint rule in `phi` takes the disc's edge without the square root's
+    /// singularity. `environment_sun_disc_pixel_radiance` is the GPU twin.
+    pub fn pixel_radiance_of(
+        &self,
+        irradiance: Vec3,
+        dir: Vec3,
+        step_x: Vec3,
+        step_y: Vec3,
+    ) -> Vec3 {
+        let radius = self.cos_radius.clamp(-1.0, 1.0).acos();
+        let half = Vec2::new(step_x.length(), step_y.length()) * 0.5;
+        let from_sun = dir - self.direction;
+        if radius <= 0.0 || half.min_element() <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let centre = Vec2::new(
+            from_sun.dot(step_x) / (2.0 * half.x),
+            from_sun.dot(step_y) / (2.0 * half.y),
+        );
+        let (lo, hi) = (centre - half, centre + half);
+        let phi = |y: f32| (y / radius).clamp(-1.0, 1.0).asin();
+        let (phi_lo, phi_hi) = (phi(lo.y), phi(hi.y));
+        if phi_hi <= phi_lo || lo.x >= radius || hi.x <= -radius {
+            return Vec3::ZERO;
+        }
+        let u = self.limb_darkening;
+        let dphi = (phi_hi - phi_lo) / SUN_PIXEL_ROWS as f32;
+        let mut sum = 0.0;
+        for k in 0..SUN_PIXEL_ROWS {
+            let p = phi_lo + (k as f32 + 0.5) * dphi;
+            let w = radius * p.cos();
+            let (a, b) = (lo.x.clamp(-w, w), hi.x.clamp(-w, w));
+            let chord = |x: f32| {
+                0.5 * (x * (w * w - x * x).max(0.0).sqrt()
+                    + w * w * (x / w).clamp(-1.0, 1.0).asin())
+            };
+            let row = (1.0 - u) * (b - a) + u / radius * (chord(b) - chord(a));
+            sum += row * w * dphi;
+        }
+        let omega = TAU * (1.0 - self.cos_radius);
+        irradiance * (sum / (1.0 - u / 3.0) / omega / (4.0 * half.x * half.y))
     }
 
     /// [`SunDisc::radiance_of`] the disc's own irradiance.
@@ -241,6 +298,15 @@ impl ViewedEnvironment {
     /// Sun irradiance reaching `p` on a surface facing the sun: `environment_sun_irradiance`.
     pub fn sun_irradiance(&self, p: Vec3) -> Vec3 {
         self.env.sun.irradiance * self.sun_transmittance(p)
+    }
+
+    /// Mean radiance of the sun's disc over the pixel around `dir` with sides `step_x`, `step_y`
+    /// ([`SunDisc::pixel_radiance_of`]): `environment_sun_disc_pixel_radiance`.
+    pub fn sun_disc_pixel_radiance(&self, dir: Vec3, step_x: Vec3, step_y: Vec3) -> Vec3 {
+        let irradiance = self.sun_irradiance(self.viewpoint_m);
+        self.env
+            .sun
+            .pixel_radiance_of(irradiance, dir, step_x, step_y)
     }
 
     /// Radiance of the sun's disc seen from the viewpoint along `dir`:
@@ -355,5 +421,69 @@ mod tests {
         // f32 resolves cos theta near 1 to about 6e-8, 0.5 % of the disc's 1 - cos r = 1.1e-5.
         let relative = (total - sun.irradiance).abs().max_element() / sun.irradiance.max_element();
         assert!(relative < 0.02, "{total} vs {}", sun.irradiance);
+    }
+
+    /// A pixel grid around the sun, `size` radians per pixel, shifted by `shift` pixels: each
+    /// pixel's centre direction and its two sides.
+    fn pixels_around(sun: &SunDisc, size: f32, shift: Vec2) -> Vec<(Vec3, Vec3, Vec3)> {
+        let e1 = sun.direction.any_orthonormal_vector();
+        let e2 = sun.direction.cross(e1);
+        let n = (4.0 * sun.cos_radius.acos() / size).ceil() as i32 + 2;
+        let mut pixels = Vec::new();
+        for j in -n..=n {
+            for i in -n..=n {
+                let at = (Vec2::new(i as f32, j as f32) + shift) * size;
+                let dir = (sun.direction + e1 * at.x + e2 * at.y).normalize();
+                pixels.push((dir, e1 * size, e2 * size));
+            }
+        }
+        pixels
+    }
+
+    #[test]
+    fn an_anti_aliased_sun_keeps_its_flux_wherever_it_falls() {
+        let sun = Environment::from_scene(&Scene::default()).sun;
+        let radius = sun.cos_radius.acos();
+        for (size, shift) in [
+            (radius * 3.0, Vec2::ZERO),
+            (radius * 1.3, Vec2::new(0.31, -0.47)),
+            (radius * 0.4, Vec2::new(0.5, 0.5)),
+            (radius * 0.07, Vec2::new(0.13, 0.71)),
+        ] {
+            let flux: Vec3 = pixels_around(&sun, size, shift)
+                .iter()
+                .map(|(d, x, y)| sun.pixel_radiance_of(sun.irradiance, *d, *x, *y) * size * size)
+                .sum();
+            let relative =
+                (flux - sun.irradiance).abs().max_element() / sun.irradiance.max_element();
+            assert!(
+                relative < 0.01,
+                "pixel {size} rad, shift {shift}: {flux} vs {}",
+                sun.irradiance
+            );
+        }
+    }
+
+    #[test]
+    fn a_pixel_far_smaller_than_the_sun_sees_its_radiance_there() {
+        let sun = Environment::from_scene(&Scene::default()).sun;
+        let size = sun.cos_radius.acos() * 0.01;
+        for (dir, x, y) in pixels_around(&sun, size * 40.0, Vec2::new(0.2, 0.3)) {
+            let point = sun.radiance(dir);
+            let pixel = sun.pixel_radiance_of(sun.irradiance, dir, x / 40.0, y / 40.0);
+            let near_rim = (sun.radiance(dir + x / 40.0) - point).abs().max_element() > 0.0
+                || (sun.radiance(dir + y / 40.0) - point).abs().max_element() > 0.0;
+            if !near_rim {
+                assert!(
+                    (pixel - point).abs().max_element() <= 0.01 * point.max_element() + 1e-6,
+                    "{pixel} vs {point}"
+                );
+            }
+        }
+        let far = (sun.direction + Vec3::X * 0.05).normalize();
+        assert_eq!(
+            sun.pixel_radiance_of(sun.irradiance, far, Vec3::X * size, Vec3::Z * size),
+            Vec3::ZERO
+        );
     }
 }

@@ -1,5 +1,5 @@
 // Composes the cloud output over what lies behind it: the host's geometry where its depth buffer
-// holds some, else the sky, the sun's disc and the ground in the clouds' shadows. Aerial
+// holds some, else the sky, the sun's disc (its mean over the pixel: anti-aliased) and the ground in the clouds' shadows. Aerial
 // perspective is applied here, once: to the background at its distance and to the clouds at their
 // distance. final = background * transmittance + hazed cloud radiance.
 
@@ -41,7 +41,9 @@ fn compose_background(px: vec2<u32>) -> vec3<f32> {
     if ground_m < frame.far_m {
         return environment_aerial_perspective(compose_ground(o + d * ground_m), 1.0, uv, ground_m);
     }
-    return environment_sky_radiance(d) + environment_sun_disc_radiance(d);
+    let step_x = frame_ray_direction(pixel + vec2<f32>(1.0, 0.0)) - d;
+    let step_y = frame_ray_direction(pixel + vec2<f32>(0.0, 1.0)) - d;
+    return environment_sky_radiance(d) + environment_sun_disc_pixel_radiance(d, step_x, step_y);
 }
 
 @compute @workgroup_size(8, 8)

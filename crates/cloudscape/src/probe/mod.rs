@@ -74,6 +74,9 @@ pub enum ProbeFunction {
     /// `sprite_level(colours a + k^2 b for k = 0..4, heights (c, d.x), h d.y)`:
     /// `sprites::shading::level_at`.
     SpriteLevel = 26,
+    /// `environment_sun_disc_pixel_radiance(a.xyz, b.xyz, c.xyz)`:
+    /// `ViewedEnvironment::sun_disc_pixel_radiance`.
+    SunDiscPixelRadiance = 27,
 }
 
 /// The inputs of one evaluation.
