@@ -900,7 +900,8 @@ pub struct RenderSettings {
     pub primary_steps: Option<u32>,
     /// Overrides the preset's steps toward the sun per sample, 1..64.
     pub light_steps: Option<u32>,
-    /// Overrides the preset's jittered passes averaged per pixel, 1..1024.
+    /// Overrides the preset's jittered passes averaged per pixel, 1..1024; each crosses the pixel at
+    /// its own point, so several integrate the pixel's footprint (anti-aliasing).
     pub samples_per_pixel: Option<u32>,
     /// Skip the empty space above the clouds with the hierarchical height map (same image, less
     /// work). On by default.
