@@ -285,7 +285,7 @@ fn coverage_remap_bound(gradient: f32, coverage: f32, type_max: f32, f_max: f32)
 }
 
 /// World box of a voxel grid.
-fn volume_box(v: &PlacedVolume) -> Aabb {
+pub(crate) fn volume_box(v: &PlacedVolume) -> Aabb {
     Aabb {
         min: v.min_m,
         max: v.min_m + v.size_m,

@@ -8,7 +8,9 @@
 //!   phase sampling, Russian roulette, Lambertian ground;
 //! - [`render::ProgressiveRender`]: passes over all cores, deterministic per seed, stoppable;
 //! - [`particle_set_medium::ParticleSetMedium`]: the particle technique's own particles as a
-//!   medium (Yusov 2014), path traced by [`PathTracer::for_particle_set`].
+//!   medium (Yusov 2014), path traced by [`PathTracer::for_particle_set`];
+//! - [`regions`]: which part of the picture each pixel shows (cloud, clear sky, ground, the sun's
+//!   neighbourhood), so errors can be told apart by region.
 //!
 //! ```no_run
 //! use cloudscape::scene::SceneDocument;
@@ -32,6 +34,7 @@ pub mod majorant;
 pub mod medium;
 pub mod particle_medium;
 pub mod particle_set_medium;
+pub mod regions;
 pub mod render;
 pub mod rng;
 pub mod sampling;

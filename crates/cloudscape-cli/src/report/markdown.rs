@@ -4,6 +4,7 @@ use super::chart::ChartSeries;
 use super::measure::Variant;
 use super::{ReportArgs, Row, particles, sprites};
 use cloudscape::scene::{LightingModel, Technique};
+use cloudscape_reference::regions::Region;
 use std::fmt::Write as _;
 
 /// The report's markdown.
@@ -11,6 +12,7 @@ pub fn document(rows: &[Row], args: &ReportArgs, adapter: &str) -> String {
     let mut s = String::new();
     introduction(&mut s, args, adapter);
     raymarch_section(&mut s, rows);
+    regions_section(&mut s, rows);
     targets_section(&mut s, rows);
     cost_section(&mut s, rows);
     particles::markdown(
@@ -90,6 +92,43 @@ fn raymarch_section(s: &mut String, rows: &[Row]) {
             r.noise.halves.flip_mean,
             r.reference.spp(),
             r.reference.samples_per_second()
+        );
+    }
+}
+
+/// The ray marcher's errors by region, beside the reference's own noise there.
+fn regions_section(s: &mut String, rows: &[Row]) {
+    let _ = writeln!(
+        s,
+        "\n## Errors by region\n\n\
+         Each pixel is classified by the ray through its centre (`cloudscape_reference::regions`): \
+         the sun's neighbourhood within 2.5 degrees of the sun, else cloud where the ray meets an \
+         optical depth of 0.05 before the ground or the far distance, else ground, else clear sky. \
+         Each cell is the ray marcher's mean HDR-FLIP over the region's pixels; *reference noise* \
+         is the reference's own estimated error there, and the luminance ratios are the ray \
+         marcher's mean luminance over the reference's in the region.\n\n\
+         | scene | cloud share | cloud HDR-FLIP | cloud reference noise | cloud luminance ratio | clear sky HDR-FLIP | ground HDR-FLIP | ground luminance ratio | sun HDR-FLIP | luminance ratio without the sun |\n\
+         |---|---|---|---|---|---|---|---|---|---|"
+    );
+    let flip = |e: Option<f64>| e.map_or_else(|| "-".to_string(), |v| format!("{v:.4}"));
+    let ratio = |e: Option<f64>| e.map_or_else(|| "-".to_string(), |v| format!("{v:.3}"));
+    for r in rows {
+        let (m, noise) = (&r.raymarch_regions, &r.noise_regions);
+        let cloud = m.get(Region::Cloud);
+        let ground = m.get(Region::Ground);
+        let _ = writeln!(
+            s,
+            "| {} | {:.0} % | {} | {} | {} | {} | {} | {} | {} | {} |",
+            r.canonical.title,
+            100.0 * cloud.share,
+            flip(cloud.flip_mean),
+            flip(noise.get(Region::Cloud).flip_mean),
+            ratio(cloud.luminance_ratio),
+            flip(m.get(Region::ClearSky).flip_mean),
+            flip(ground.flip_mean),
+            ratio(ground.luminance_ratio),
+            flip(m.get(Region::Sun).flip_mean),
+            ratio(m.luminance_ratio_without_sun),
         );
     }
 }

@@ -13,6 +13,7 @@ mod measure;
 mod noise;
 mod particles;
 mod references;
+mod regions;
 mod sprites;
 
 use crate::common::GpuArgs;
@@ -79,6 +80,10 @@ pub struct Row {
     variants: Vec<(Variant, Comparison, f64)>,
     /// The ray marcher as the scene renders itself.
     raymarch: Comparison,
+    /// The ray marcher's errors by region.
+    raymarch_regions: regions::RegionErrors,
+    /// The reference's own estimated error by region ([`noise::own_noise_image`]).
+    noise_regions: regions::RegionErrors,
     /// The particle technique's rows; None where the scene makes no particles.
     particles: Option<particles::ParticleRow>,
     /// The sprite technique's row; None where the sprites show none of the scene's clouds.
@@ -169,6 +174,9 @@ fn scene_row(
     let reference = field_reference(canonical.name, doc, (args, store), &key)?;
     let full = reference.image();
     let noise = ReferenceNoise::of(&reference, &full)?;
+    let pixel_regions = regions::of_scene(doc)?;
+    let noise_regions =
+        regions::RegionErrors::of(&full, &noise::own_noise_image(&reference), &pixel_regions)?;
     let name = canonical.name;
     let image_path = |kind: &str| images.join(format!("{name}-{kind}.png"));
     let (ev, op) = (doc.scene.render.exposure_ev, doc.scene.render.tonemap);
@@ -180,6 +188,7 @@ fn scene_row(
     };
     let (mut variants, mut raymarch, mut particle_row, mut sprite_row) =
         (Vec::new(), None, None, None);
+    let mut raymarch_regions = None;
     for variant in Variant::all()
         .into_iter()
         .filter(|v| v.shows_clouds_of(&doc.scene))
@@ -199,7 +208,15 @@ fn scene_row(
         match variant.technique {
             Technique::Raymarch => {
                 m.write_images(&full, &image_path("raymarch"), &image_path("flip"))?;
+                m.rendered
+                    .hdr
+                    .write_exr(&images.join(format!("{name}-raymarch.exr")))?;
                 raymarch = Some(m.comparison.clone());
+                raymarch_regions = Some(regions::RegionErrors::of(
+                    &full,
+                    &m.rendered.hdr,
+                    &pixel_regions,
+                )?);
             }
             Technique::Particles => {
                 particle_row = particles::row(name, &m, &sources, (&full, images))?;
@@ -221,6 +238,8 @@ fn scene_row(
         noise,
         variants,
         raymarch: raymarch.context("the ray marcher at the scene's quality was not measured")?,
+        raymarch_regions: raymarch_regions.context("the ray marcher's regions")?,
+        noise_regions,
         particles: particle_row,
         sprites: sprite_row,
     })

@@ -64,6 +64,12 @@ pub fn own_error(reference: &Reference, image: &HdrImage) -> Result<Comparison> 
     against_own_noise(reference, image, 1.0)
 }
 
+/// The reference plus noise of its own size: as far from the reference, in distribution, as the
+/// reference is from the converged image.
+pub fn own_noise_image(reference: &Reference) -> HdrImage {
+    with_own_noise(reference, 1.0)
+}
+
 /// `image`, the reference, against itself plus `amplitude` times noise of its own size.
 fn against_own_noise(
     reference: &Reference,

@@ -83,12 +83,19 @@ fn aces_input_for(t: f32) -> f32 {
 }
 
 /// HDR-FLIP of `test` against `reference` (linear radiance): the statistics of the per-pixel
-/// error map (each pixel the largest LDR-FLIP error over the exposures of
-/// [`ExposureRange::of_reference`]) and that map coloured with magma.
+/// error map ([`hdr_flip_errors`]) and that map coloured with magma.
 pub fn hdr_flip(
     reference: &HdrImage,
     test: &HdrImage,
 ) -> Result<(FlipStats, super::LdrImage), ImageError> {
+    let errors = hdr_flip_errors(reference, test)?;
+    let map = nv_flip::FlipImageFloat::with_data(reference.width, reference.height, &errors);
+    Ok(summarise(&map))
+}
+
+/// The per-pixel HDR-FLIP error of `test` against `reference`, row by row: each pixel the largest
+/// LDR-FLIP error over the exposures of [`ExposureRange::of_reference`] (Andersson et al. 2021).
+pub fn hdr_flip_errors(reference: &HdrImage, test: &HdrImage) -> Result<Vec<f32>, ImageError> {
     let size = |i: &HdrImage| (i.width, i.height, i.pixels.len());
     check_same_size(size(reference), size(test))?;
     let range = ExposureRange::of_reference(reference);
@@ -104,8 +111,7 @@ pub fn hdr_flip(
             .zip(errors)
             .for_each(|(w, e)| *w = w.max(e));
     }
-    let map = nv_flip::FlipImageFloat::with_data(reference.width, reference.height, &worst);
-    Ok(summarise(&map))
+    Ok(worst)
 }
 
 #[cfg(test)]

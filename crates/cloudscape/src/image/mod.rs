@@ -20,7 +20,7 @@ pub use compare::relative_mse;
 #[cfg(feature = "flip")]
 pub use flip::{FlipStats, flip};
 #[cfg(feature = "flip")]
-pub use hdr_flip::{ExposureRange, hdr_flip};
+pub use hdr_flip::{ExposureRange, hdr_flip, hdr_flip_errors};
 #[cfg(any(feature = "png", feature = "exr"))]
 pub use io::write_image;
 
@@ -166,16 +166,14 @@ impl HdrImage {
         if self.pixels.is_empty() {
             return 0.0;
         }
-        let total: f64 = self
-            .pixels
-            .iter()
-            .map(|p| {
-                (0..3)
-                    .map(|c| LUMINANCE_WEIGHTS[c] * f64::from(p[c]))
-                    .sum::<f64>()
-            })
-            .sum();
+        let total: f64 = (0..self.pixels.len()).map(|i| self.luminance(i)).sum();
         total / self.pixels.len() as f64
+    }
+
+    /// Rec. 709 luminance of pixel `index` (row by row).
+    pub fn luminance(&self, index: usize) -> f64 {
+        let p = self.pixels[index];
+        (0..3).map(|c| LUMINANCE_WEIGHTS[c] * f64::from(p[c])).sum()
     }
 }
 
