@@ -2,6 +2,7 @@
 
 use super::chart::ChartSeries;
 use super::measure::Variant;
+use super::regions::RegionErrors;
 use super::{ReportArgs, Row, particles, sprites};
 use cloudscape::scene::{LightingModel, Technique};
 use cloudscape_reference::regions::Region;
@@ -129,6 +130,34 @@ fn regions_section(s: &mut String, rows: &[Row]) {
             ratio(ground.luminance_ratio),
             flip(m.get(Region::Sun).flip_mean),
             ratio(m.luminance_ratio_without_sun),
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nEvery technique on the same footing: cloud-region HDR-FLIP and luminance ratio (the \
+         particles and the sprites against the field's reference, where they show the scene's \
+         clouds).\n\n\
+         | scene | ray marcher cloud HDR-FLIP / luminance ratio | particles | sprites | cloud reference noise |\n\
+         |---|---|---|---|---|"
+    );
+    let cell = |e: Option<&RegionErrors>| {
+        e.map_or_else(
+            || "-".to_string(),
+            |e| {
+                let c = e.get(Region::Cloud);
+                format!("{} / {}", flip(c.flip_mean), ratio(c.luminance_ratio))
+            },
+        )
+    };
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} |",
+            r.canonical.title,
+            cell(Some(&r.raymarch_regions)),
+            cell(r.other_regions[0].as_ref()),
+            cell(r.other_regions[1].as_ref()),
+            flip(r.noise_regions.get(Region::Cloud).flip_mean),
         );
     }
 }

@@ -84,6 +84,8 @@ pub struct Row {
     raymarch_regions: regions::RegionErrors,
     /// The reference's own estimated error by region ([`noise::own_noise_image`]).
     noise_regions: regions::RegionErrors,
+    /// The particles' and the sprites' errors by region, where they show the scene's clouds.
+    other_regions: [Option<regions::RegionErrors>; 2],
     /// The particle technique's rows; None where the scene makes no particles.
     particles: Option<particles::ParticleRow>,
     /// The sprite technique's row; None where the sprites show none of the scene's clouds.
@@ -188,7 +190,7 @@ fn scene_row(
     };
     let (mut variants, mut raymarch, mut particle_row, mut sprite_row) =
         (Vec::new(), None, None, None);
-    let mut raymarch_regions = None;
+    let (mut raymarch_regions, mut other_regions) = (None, [None, None]);
     for variant in Variant::all()
         .into_iter()
         .filter(|v| v.shows_clouds_of(&doc.scene))
@@ -219,9 +221,19 @@ fn scene_row(
                 )?);
             }
             Technique::Particles => {
+                other_regions[0] = Some(regions::RegionErrors::of(
+                    &full,
+                    &m.rendered.hdr,
+                    &pixel_regions,
+                )?);
                 particle_row = particles::row(name, &m, &sources, (&full, images))?;
             }
             Technique::Sprites => {
+                other_regions[1] = Some(regions::RegionErrors::of(
+                    &full,
+                    &m.rendered.hdr,
+                    &pixel_regions,
+                )?);
                 sprite_row = Some(sprites::row(name, &mut m, ctx, (&full, images))?);
             }
         }
@@ -240,6 +252,7 @@ fn scene_row(
         raymarch: raymarch.context("the ray marcher at the scene's quality was not measured")?,
         raymarch_regions: raymarch_regions.context("the ray marcher's regions")?,
         noise_regions,
+        other_regions,
         particles: particle_row,
         sprites: sprite_row,
     })
