@@ -267,16 +267,6 @@ impl FieldGpu {
         ctx.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
-
-    /// The layout of bind group 0, for techniques' pipeline layouts.
-    pub fn layout(&self) -> &wgpu::BindGroupLayout {
-        &self.layout
-    }
-
-    /// Bind group 0.
-    pub fn bind_group(&self) -> &wgpu::BindGroup {
-        &self.bind_group
-    }
 }
 
 /// Bind group 0: the uniform, the noise, weather and atlas textures, the samplers, the pyramid.
