@@ -106,11 +106,17 @@ impl Environment {
 
     /// What the eye sees of radiance `radiance` from `distance_m` away along `dir` through the
     /// air or haze: the aerial perspective the GPU compositor applies
-    /// ([`ViewedEnvironment::aerial_perspective`] at full coverage; the air here is not shadowed
-    /// by the clouds).
-    pub fn through_haze(&self, radiance: Vec3, dir: Vec3, distance_m: f32) -> Vec3 {
+    /// ([`ViewedEnvironment::aerial_perspective`] at full coverage), the air's sunlit
+    /// in-scattering at distance `t` dimmed by `sun_visibility(t)`, the clouds' transmittance
+    /// toward the sun there (the GPU reads it from the cloud shadow map: light shafts).
+    pub fn through_haze(
+        &self,
+        radiance: Vec3,
+        (dir, distance_m): (Vec3, f32),
+        sun_visibility: impl FnMut(f32) -> f32,
+    ) -> Vec3 {
         match &self.atmosphere {
-            Some(a) => a.aerial_perspective((radiance, 1.0), (dir, distance_m), |_| 1.0),
+            Some(a) => a.aerial_perspective((radiance, 1.0), (dir, distance_m), sun_visibility),
             None => {
                 let clear = (-self.sky.haze_per_m * distance_m).exp();
                 radiance * clear + self.sky.horizon * (1.0 - clear)

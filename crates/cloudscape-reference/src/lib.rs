@@ -50,4 +50,7 @@ pub use scene::DEFAULT_MAJORANT_CELLS;
 /// The revision of what the path tracer converges to: raised by every change that moves its
 /// expected image (a fix, a new effect), and only by those, so that references stored with an
 /// older revision are traced anew while changes that only lower the noise keep them.
-pub const TRACER_REVISION: u32 = 1;
+///
+/// 2: the air's sunlit in-scattering is shadowed by the clouds, and alpha holds the share of a
+/// pixel's paths that met cloud.
+pub const TRACER_REVISION: u32 = 2;

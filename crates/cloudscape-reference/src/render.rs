@@ -1,9 +1,10 @@
 //! Progressive rendering: passes of samples per pixel over all cores, accumulated per pixel with
 //! the statistics to tell how converged each pixel is; stoppable between rows.
 
-use crate::integrator::PathTracer;
+use crate::integrator::{CameraSample, PathTracer};
 use crate::medium::Medium;
 use crate::rng::Rng;
+use cloudscape::frame::Frame;
 use cloudscape::image::HdrImage;
 use glam::{DVec3, Vec2};
 use rayon::prelude::*;
@@ -11,6 +12,9 @@ use std::time::{Duration, Instant};
 
 /// Rec. 709 luminance weights of linear sRGB (ITU-R BT.709).
 const LUMINANCE: DVec3 = DVec3::new(0.2126, 0.7152, 0.0722);
+
+/// The stream of random numbers that rotates a pixel's sample points (never a sample's index).
+const PIXEL_ROTATION_STREAM: u64 = u64::MAX;
 
 /// One pixel's running sums.
 #[derive(Clone, Copy, Debug, Default)]
@@ -22,6 +26,8 @@ struct PixelSums {
     sum_sq_luminance: f64,
     /// Estimates dropped for not being finite (a bug if ever non-zero; counted, never hidden).
     non_finite: u32,
+    /// Samples whose path met cloud.
+    met_cloud: u32,
 }
 
 /// A pixel's estimate and its uncertainty.
@@ -90,6 +96,11 @@ impl<'a, M: Medium> ProgressiveRender<'a, M> {
     /// it says yes, the remaining rows of the pass are skipped (their pixels keep fewer samples).
     /// `row_done` is told how many samples each finished row added. Returns whether the pass
     /// completed.
+    ///
+    /// Sample `s` of a pixel crosses it at the R2 point `s` ([`Frame::footprint_point`]) shifted
+    /// by a random offset per pixel and seed (a Cranley-Patterson rotation, 1976): each sample is
+    /// uniform over the pixel, so the estimate stays unbiased, while together they cover it
+    /// evenly (a sun disc smaller than a pixel no longer flickers from seed to seed).
     pub fn run_pass(
         &mut self,
         spp: u32,
@@ -108,10 +119,12 @@ impl<'a, M: Medium> ProgressiveRender<'a, M> {
                 }
                 for (x, pixel) in row.iter_mut().enumerate() {
                     let index = (y * width + x) as u64;
+                    let rotation = Rng::for_sample(seed, index, PIXEL_ROTATION_STREAM).next_vec2();
                     for s in first..first + spp {
                         let mut rng = Rng::for_sample(seed, index, u64::from(s));
-                        let point = Vec2::new(x as f32, y as f32) + rng.next_vec2();
-                        pixel.add(tracer.radiance(point, &mut rng).as_dvec3());
+                        let within = (Frame::footprint_point(s, u32::MAX) + rotation).fract();
+                        let point = Vec2::new(x as f32, y as f32) + within;
+                        pixel.add(tracer.camera_sample(point, &mut rng));
                     }
                 }
                 row_done(u64::from(spp) * width as u64);
@@ -123,15 +136,18 @@ impl<'a, M: Medium> ProgressiveRender<'a, M> {
         complete
     }
 
-    /// The image so far: each pixel's mean (black where no sample was taken), alpha 1.
+    /// The image so far: each pixel's mean (black where no sample was taken), and in alpha the
+    /// share of its paths that met cloud ([`CameraSample::met_cloud`]).
     pub fn image(&self) -> HdrImage {
         let size = self.tracer.frame.size;
         let pixels = self
             .pixels
             .iter()
             .map(|p| {
-                let m = p.sum / f64::from(p.samples.max(1));
-                [m.x as f32, m.y as f32, m.z as f32, 1.0]
+                let n = f64::from(p.samples.max(1));
+                let m = p.sum / n;
+                let cloud = f64::from(p.met_cloud) / n;
+                [m.x as f32, m.y as f32, m.z as f32, cloud as f32]
             })
             .collect();
         HdrImage {
@@ -157,12 +173,14 @@ impl<'a, M: Medium> ProgressiveRender<'a, M> {
 }
 
 impl PixelSums {
-    fn add(&mut self, radiance: DVec3) {
+    fn add(&mut self, sample: CameraSample) {
+        let radiance = sample.radiance.as_dvec3();
         if !radiance.is_finite() {
             self.non_finite += 1;
             return;
         }
         self.samples += 1;
+        self.met_cloud += u32::from(sample.met_cloud);
         self.sum += radiance;
         self.sum_sq_luminance += radiance.dot(LUMINANCE).powi(2);
     }

@@ -82,10 +82,7 @@ impl PathTracer<ParticleSetMedium> {
         sigma_max_per_m: f32,
         majorant_cells: usize,
     ) -> PathTracer<ParticleSetMedium> {
-        let planet = PlanetGeometry {
-            shape: scene.planet.shape,
-            radius_m: scene.planet.radius_m,
-        };
+        let planet = PlanetGeometry::from_scene(&scene.planet);
         PathTracer::in_scene(scene, size, planet, majorant_cells, |frame| {
             let camera = frame.camera_position_m;
             let seen: Vec<Particle> = particles

@@ -206,6 +206,11 @@ fn seeds_agree_within_variance_and_repeat_exactly() {
     );
     assert_eq!(render(1, &[40, 56]).image(), a.image());
     assert_eq!(a.stats().non_finite, 0);
+    // Alpha holds the share of each pixel's paths that met cloud: the report's cloud mask.
+    let image = a.image();
+    let share = |x: usize, y: usize| image.pixels[y * 6 + x][3];
+    assert!(share(2, 1) > 0.9 && share(3, 2) > 0.9, "{}", share(2, 1));
+    assert_eq!(share(0, 1), 0.0, "only ground and sky beside the cube");
     // A render continuing seed 1 from sample 40 holds exactly the samples the first 40 lack.
     let mut rest = ProgressiveRender::starting_at(&t, 1, 40);
     assert!(rest.run_pass(56, &|| false, &|_| {}));

@@ -58,3 +58,38 @@ fn samples_spread_over_the_pixel_find_the_cube_s_edges() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The rasterising techniques integrate the footprint by drawing the frame once per sample, each
+/// shifted to its own point of the pixel: with 8 samples the particles' picture changes along the
+/// clouds' outlines (it would not if the frames were not shifted) while its mean brightness stays.
+#[test]
+fn particles_average_frames_shifted_over_the_pixel() {
+    let ctx = GpuContext::for_tests();
+    let render = |samples: u32| {
+        let overrides = [
+            "render.technique=particles".to_string(),
+            "render.width=96".to_string(),
+            "render.height=54".to_string(),
+            format!("render.samples_per_pixel={samples}"),
+        ];
+        let doc = SceneDocument::parse("", "footprint", std::path::Path::new("."), &overrides)
+            .expect("valid scene");
+        let mut renderer = SceneRenderer::new(&ctx, &doc.scene, std::path::Path::new("."))
+            .expect("the default field");
+        renderer.render(&ctx, |_| {}).hdr
+    };
+    let (one, eight) = (render(1), render(8));
+    let changed = one
+        .pixels
+        .iter()
+        .zip(&eight.pixels)
+        .filter(|(a, b)| (a[1] - b[1]).abs() > 0.02 * a[1].abs().max(1e-3))
+        .count();
+    let ratio = eight.mean_luminance() / one.mean_luminance();
+    eprintln!("{changed} pixels changed, mean luminance ratio {ratio}");
+    assert!(changed >= 50, "only {changed} pixels changed");
+    assert!(
+        (0.97..1.03).contains(&ratio),
+        "mean luminance ratio {ratio}"
+    );
+}

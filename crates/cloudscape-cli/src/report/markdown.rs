@@ -102,9 +102,11 @@ fn regions_section(s: &mut String, rows: &[Row]) {
     let _ = writeln!(
         s,
         "\n## Errors by region\n\n\
-         Each pixel is classified by the ray through its centre (`cloudscape_reference::regions`): \
-         the sun's neighbourhood within 2.5 degrees of the sun, else cloud where the ray meets an \
-         optical depth of 0.05 before the ground or the far distance, else ground, else clear sky. \
+         Each pixel is classified from the mask the path tracer records \
+         (`cloudscape_reference::regions`): the sun's neighbourhood within 2.5 degrees of the sun, \
+         else cloud where at least 5 % of the reference's camera paths through the pixel met cloud \
+         before leaving the scene or reaching the ground, else ground where the ray through its \
+         centre reaches the ground, else clear sky. \
          Each cell is the ray marcher's mean HDR-FLIP over the region's pixels; *reference noise* \
          is the reference's own estimated error there, and the luminance ratios are the ray \
          marcher's mean luminance over the reference's in the region.\n\n\

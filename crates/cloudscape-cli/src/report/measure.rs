@@ -23,6 +23,11 @@ pub struct Variant {
     pub lighting: Option<LightingModel>,
 }
 
+/// Samples per pixel of the rasterising techniques' compared images: each draws the whole frame
+/// through its own point of the pixel ([`SceneRenderer::render`]), so they integrate the pixel's
+/// footprint as the path tracer does (the ray marcher does so within its march).
+const RASTER_FOOTPRINT_SAMPLES: u32 = 8;
+
 /// The quality presets from fast to converged.
 const PRESETS: [Quality; 4] = [Quality::Low, Quality::Medium, Quality::High, Quality::Ultra];
 
@@ -82,6 +87,9 @@ impl Variant {
         if let Some(l) = self.lighting {
             scene.lighting.model = l;
         }
+        if self.technique != Technique::Raymarch {
+            scene.render.samples_per_pixel = Some(RASTER_FOOTPRINT_SAMPLES);
+        }
         scene
     }
 }
@@ -133,7 +141,10 @@ pub fn measure(
         .render_frame(ctx, &frame, Reuse::None, &mut timer)
         .as_secs_f64()
         * 1e3;
-    let rendered = renderer.images(ctx);
+    let rendered = match scene.render.technique {
+        Technique::Raymarch => renderer.images(ctx),
+        Technique::Particles | Technique::Sprites => renderer.render(ctx, |_| {}),
+    };
     let comparison = Comparison::of(reference, &rendered.hdr, None)?;
     Ok(Measurement {
         rendered,

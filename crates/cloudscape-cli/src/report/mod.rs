@@ -176,7 +176,7 @@ fn scene_row(
     let reference = field_reference(canonical.name, doc, (args, store), &key)?;
     let full = reference.image();
     let noise = ReferenceNoise::of(&reference, &full)?;
-    let pixel_regions = regions::of_scene(doc)?;
+    let pixel_regions = regions::of_scene(doc, &full);
     let noise_regions =
         regions::RegionErrors::of(&full, &noise::own_noise_image(&reference), &pixel_regions)?;
     let name = canonical.name;

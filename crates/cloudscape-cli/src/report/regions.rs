@@ -2,8 +2,8 @@
 //! sky, ground or the sun's neighbourhood ([`cloudscape_reference::regions`]), beside the
 //! whole-image figures, so a change can be judged where it acts.
 
-use anyhow::{Result, anyhow};
-use cloudscape::field::CloudField;
+use anyhow::Result;
+use cloudscape::field::PlanetGeometry;
 use cloudscape::frame::Frame;
 use cloudscape::image::{HdrImage, hdr_flip_errors};
 use cloudscape::scene::SceneDocument;
@@ -74,13 +74,14 @@ impl RegionErrors {
     }
 }
 
-/// The region of every pixel of `doc`'s frame at its render size.
-pub fn of_scene(doc: &SceneDocument) -> Result<Vec<Region>> {
+/// The region of every pixel of `doc`'s frame at its render size, from the cloud mask the path
+/// tracer recorded in `reference`'s alpha.
+pub fn of_scene(doc: &SceneDocument, reference: &HdrImage) -> Vec<Region> {
     let scene = &doc.scene;
-    let field = CloudField::new(scene, &doc.resolve_path(""))
-        .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
-    let frame = Frame::from_scene(scene, UVec2::new(scene.render.width, scene.render.height));
-    Ok(classify(&field, &frame, scene.ground.enabled))
+    let frame = Frame::from_scene(scene, UVec2::new(reference.width, reference.height));
+    let planet = PlanetGeometry::from_scene(&scene.planet);
+    let share: Vec<f32> = reference.pixels.iter().map(|p| p[3]).collect();
+    classify(&frame, (&planet, scene.ground.enabled), &share)
 }
 
 #[cfg(test)]

@@ -86,3 +86,64 @@ fn a_spent_time_budget_still_writes_the_image() {
     assert!(run.stderr.contains("stopped early"));
     assert!(s.join("x.png").exists());
 }
+
+/// Under an unbroken deck, looking a few degrees down at a black ground from 200 m: every pixel
+/// is the air's own light, which the deck shadows from the sun.
+const UNDER_A_DECK: &str = r#"
+[planet]
+shape = "flat"
+[camera]
+position_m = [0.0, 200.0, 0.0]
+pitch_deg = -4.0
+fov_y_deg = 6.0
+far_m = 20000.0
+[sun]
+elevation_deg = 40.0
+[ground]
+albedo = [0.0, 0.0, 0.0]
+[[layers]]
+bottom_m = 1200.0
+thickness_m = 600.0
+coverage = 1.0
+types = { stratus = 1.0 }
+"#;
+
+/// The two renderers' air agrees under a cloud deck: the path tracer's in-scattering sees the
+/// clouds' transmittance toward the sun as the GPU's light shafts do (through the cloud shadow
+/// map). Lit as if the deck were not there, the path tracer's air is several times brighter.
+#[test]
+fn the_air_under_a_deck_is_shadowed_in_both_renderers() {
+    let s = Scratch::new("air-under-deck");
+    std::fs::write(s.join("deck.toml"), UNDER_A_DECK).expect("write scene");
+    let size = ["--width", "32", "--height", "18"];
+    let gpu = cloudscape(
+        s.path(),
+        &[&["render", "deck.toml", "--out", "gpu.exr"], &size[..]].concat(),
+        true,
+    );
+    assert!(gpu.success, "{}", gpu.stderr);
+    let traced = [&["reference", "deck.toml", "--spp", "2"], &size[..]].concat();
+    succeed(s.path(), &[&traced[..], &["--out", "deck.exr"]].concat());
+    let clear = [
+        &traced[..],
+        &["--set", "layers.0.coverage=0", "--out", "clear.exr"],
+    ]
+    .concat();
+    succeed(s.path(), &clear);
+    let mean = |name: &str| {
+        let image = HdrImage::read(&s.join(name)).expect("read image");
+        let sum: f64 = image.pixels.iter().map(|p| f64::from(p[1])).sum();
+        sum / image.pixels.len() as f64
+    };
+    let (gpu, deck, clear) = (mean("gpu.exr"), mean("deck.exr"), mean("clear.exr"));
+    assert!(deck > 0.0, "the air under the deck still scatters skylight");
+    let ratio = gpu / deck;
+    assert!(
+        (0.8..1.25).contains(&ratio),
+        "GPU {gpu} / path tracer {deck} = {ratio}"
+    );
+    assert!(
+        clear > 1.6 * deck,
+        "air without the deck {clear}, under it {deck}"
+    );
+}

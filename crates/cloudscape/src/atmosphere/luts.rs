@@ -285,7 +285,7 @@ impl SkyTables {
         span: (f32, f32),
         steps: u32,
         spacing: Spacing,
-        sun_visibility: impl Fn(f32) -> f32,
+        mut sun_visibility: impl FnMut(f32) -> f32,
     ) -> (Vec3, Vec3) {
         let air = &self.air;
         let cos_theta = ray.dir.dot(ray.sun);
@@ -339,7 +339,7 @@ impl SkyTables {
         &self,
         ray: LocalRay,
         distance_m: f32,
-        sun_visibility: impl Fn(f32) -> f32,
+        sun_visibility: impl FnMut(f32) -> f32,
     ) -> (Vec3, Vec3) {
         let step_m = AERIAL_SLICE_M / AERIAL_STEPS_PER_SLICE as f32;
         let steps = (distance_m / step_m).ceil().max(1.0) as u32;

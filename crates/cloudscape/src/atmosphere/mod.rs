@@ -97,7 +97,7 @@ impl Atmosphere {
         (p, dir): (Vec3, Vec3),
         sun: Vec3,
         distance_m: f32,
-        sun_visibility: impl Fn(f32) -> f32,
+        sun_visibility: impl FnMut(f32) -> f32,
     ) -> (Vec3, Vec3) {
         let ray = self.local_ray(p, dir, sun);
         self.tables

@@ -363,7 +363,7 @@ impl ViewedEnvironment {
         &self,
         (radiance, coverage): (Vec3, f32),
         (dir, distance_m): (Vec3, f32),
-        sun_visibility: impl Fn(f32) -> f32,
+        sun_visibility: impl FnMut(f32) -> f32,
     ) -> Vec3 {
         match &self.atmosphere {
             Some((atmosphere, _)) => {

@@ -86,6 +86,14 @@ pub struct PlanetGeometry {
 }
 
 impl PlanetGeometry {
+    /// The ground a scene's `[planet]` describes.
+    pub fn from_scene(planet: &crate::scene::Planet) -> PlanetGeometry {
+        PlanetGeometry {
+            shape: planet.shape,
+            radius_m: planet.radius_m,
+        }
+    }
+
     /// Ray parameters `(t0, t1)` between which the line `origin + t dir` is below altitude
     /// `altitude_m` (inside the sphere of radius `R + h`, or under the plane `y = h`); infinite ends
     /// for a flat planet. None when it never is. In f64: `field_below` in `field.wgsl` is the f32
@@ -264,10 +272,7 @@ impl CloudField {
             .collect::<Result<Vec<_>, FieldError>>()?;
         let seed = scene.noise.seed;
         Ok(CloudField {
-            planet: PlanetGeometry {
-                shape: scene.planet.shape,
-                radius_m: scene.planet.radius_m,
-            },
+            planet: PlanetGeometry::from_scene(&scene.planet),
             layers: scene.layers.iter().map(LayerField::new).collect(),
             weather,
             noise: scene.noise.clone(),

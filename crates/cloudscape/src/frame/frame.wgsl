@@ -23,6 +23,17 @@ struct Frame {
 
 @group(1) @binding(0) var<uniform> frame: Frame;
 
+// Where sample `index` of `samples` crosses its pixel, in pixel units from its corner: the centre
+// for one sample, else the R2 sequence (Roberts 2018, "The unreasonable effectiveness of
+// quasirandom sequences"). Frame::footprint_point is the same.
+fn frame_footprint_point(index: u32, samples: u32) -> vec2<f32> {
+    if samples <= 1u {
+        return vec2<f32>(0.5);
+    }
+    let step = vec2<f32>(FRAME_FOOTPRINT_STEP_X, FRAME_FOOTPRINT_STEP_Y);
+    return fract(vec2<f32>(0.5) + f32(index) * step);
+}
+
 // Normalised device xy of pixel coordinates `pixel` (y down).
 fn frame_ndc(pixel: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(2.0 * pixel.x / frame.viewport_px.x - 1.0, 1.0 - 2.0 * pixel.y / frame.viewport_px.y);

@@ -61,8 +61,28 @@ impl FrameUniform {
 pub type FrameGpu = UniformGroup<FrameUniform>;
 
 /// The frame on the GPU (`frame.wgsl`, group [`crate::shader::FRAME_GROUP`]).
-pub static FRAME_WGSL: crate::shader::WgslModule =
-    crate::shader::wgsl_module!("frame", "frame.wgsl", [&crate::field::noise::NOISE_WGSL]);
+pub static FRAME_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "frame",
+    "frame.wgsl",
+    [&crate::field::noise::NOISE_WGSL],
+    frame_constants
+);
+
+/// The frame's constants as WGSL: the step of the footprint's R2 sequence
+/// ([`super::FOOTPRINT_STEP`]).
+fn frame_constants() -> String {
+    use crate::shader::WgslConst::F32;
+    crate::shader::wgsl_consts([
+        (
+            "FRAME_FOOTPRINT_STEP_X",
+            F32(super::FOOTPRINT_STEP[0] as f32),
+        ),
+        (
+            "FRAME_FOOTPRINT_STEP_Y",
+            F32(super::FOOTPRINT_STEP[1] as f32),
+        ),
+    ])
+}
 
 impl crate::pass::SharedGroup for FrameGpu {
     fn layout(&self) -> &wgpu::BindGroupLayout {

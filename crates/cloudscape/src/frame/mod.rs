@@ -16,7 +16,11 @@ pub use gpu::{FRAME_WGSL, FrameGpu, FrameUniform};
 use crate::optics::PhaseLobes;
 use crate::output::SampleGrid;
 use crate::scene::{Camera, Scene, Sun, direction_from_angles_deg};
-use glam::{Mat4, UVec2, Vec3};
+use glam::{Mat4, UVec2, Vec2, Vec3};
+
+/// Step of the R2 sequence that spreads samples over a pixel: `(1/g, 1/g^2)` for the plastic
+/// number `g = 1.3247...`, the real root of `x^3 = x + 1` (Roberts 2018).
+pub const FOOTPRINT_STEP: [f64; 2] = [0.754_877_666_246_692_7, 0.569_840_290_998_053_3];
 
 /// Normalised device depth of the point `camera_ray` and `frame_ray_direction` unproject to find a
 /// pixel's ray: between the near and far planes in every [`DepthConvention`].
@@ -135,6 +139,31 @@ impl Frame {
         }
     }
 
+    /// Where sample `index` of `samples` crosses its pixel, in pixel units from its corner: the
+    /// centre for one sample, else the R2 sequence (Roberts 2018, "The unreasonable effectiveness
+    /// of quasirandom sequences": the additive recurrence by [`FOOTPRINT_STEP`]), which covers the
+    /// pixel evenly for any count. `frame_footprint_point` in `frame.wgsl` is the same.
+    pub fn footprint_point(index: u32, samples: u32) -> Vec2 {
+        if samples <= 1 {
+            return Vec2::splat(0.5);
+        }
+        let step = glam::DVec2::from_array(FOOTPRINT_STEP);
+        (glam::DVec2::splat(0.5) + step * f64::from(index))
+            .fract()
+            .as_vec2()
+    }
+
+    /// The same frame with its image shifted by `offset_px` pixels (x right, y down): every
+    /// pixel then samples the point `offset_px` from its centre (a sub-pixel jitter of the
+    /// projection).
+    pub fn shifted_by(&self, offset_px: Vec2) -> Frame {
+        let ndc = Vec2::new(-2.0, 2.0) * offset_px / self.size.as_vec2();
+        Frame {
+            clip_from_view: Mat4::from_translation(ndc.extend(0.0)) * self.clip_from_view,
+            ..self.clone()
+        }
+    }
+
     /// The same frame seen through a depth buffer of convention `depth`: the projection is rebuilt
     /// for it from the scene camera's field of view and planes.
     pub fn with_depth(self, scene: &Scene, depth: DepthConvention) -> Frame {
@@ -202,6 +231,41 @@ mod tests {
         let (_, d) = f.camera_ray(glam::Vec2::new(32.0, 18.0));
         let expect = direction_from_angles_deg(scene.camera.pitch_deg, scene.camera.yaw_deg);
         assert!(d.abs_diff_eq(expect, 1e-4), "{d} vs {expect}");
+    }
+
+    #[test]
+    fn a_shifted_frame_samples_its_pixels_off_centre() {
+        let f = Frame::from_scene(&Scene::default(), UVec2::new(64, 36));
+        let offset = glam::Vec2::new(0.3, -0.2);
+        let shifted = f.shifted_by(offset);
+        let centre = glam::Vec2::new(20.5, 7.5);
+        let (_, through_shifted) = shifted.camera_ray(centre);
+        let (_, off_centre) = f.camera_ray(centre + offset);
+        assert!(through_shifted.abs_diff_eq(off_centre, 1e-5));
+        assert!(!through_shifted.abs_diff_eq(f.camera_ray(centre).1, 1e-5));
+    }
+
+    #[test]
+    fn footprint_points_cover_the_pixel_evenly() {
+        assert_eq!(Frame::footprint_point(0, 1), glam::Vec2::splat(0.5));
+        let points: Vec<_> = (0..16).map(|i| Frame::footprint_point(i, 16)).collect();
+        assert!(
+            points
+                .iter()
+                .all(|p| p.cmpge(glam::Vec2::ZERO).all() && p.cmplt(glam::Vec2::ONE).all())
+        );
+        // Every quarter of the pixel holds 3 to 5 of the 16 points (4 if perfectly even).
+        for quarter in 0..4 {
+            let corner = glam::Vec2::new((quarter % 2) as f32, (quarter / 2) as f32) * 0.5;
+            let inside = points
+                .iter()
+                .filter(|p| {
+                    (**p - corner).cmpge(glam::Vec2::ZERO).all()
+                        && (**p - corner).cmplt(glam::Vec2::splat(0.5)).all()
+                })
+                .count();
+            assert!((3..=5).contains(&inside), "quarter {quarter}: {inside}");
+        }
     }
 
     #[test]

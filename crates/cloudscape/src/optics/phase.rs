@@ -21,6 +21,15 @@ pub const MIE_FIT_MIN_DIAMETER_UM: f32 = 5.0;
 /// Largest droplet diameter, in micrometres, of the approximate-Mie fit (Jendersie & d'Eon 2023).
 pub const MIE_FIT_MAX_DIAMETER_UM: f32 = 50.0;
 
+/// One of the two lobes of a [`PhaseLobes`] mixture.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lobe {
+    /// The Henyey-Greenstein lobe (for droplets, the narrow diffraction peak).
+    HenyeyGreenstein,
+    /// The Draine lobe (for droplets, the broad rest).
+    Draine,
+}
+
 /// A mixture of a Henyey-Greenstein lobe and a Draine lobe:
 /// `p(mu) = (1 - w_draine) * HG(g_hg, mu) + w_draine * Draine(g_draine, alpha, mu)`.
 ///
@@ -113,23 +122,61 @@ impl PhaseLobes {
     /// Importance-samples the direction after scattering, exactly distributed as [`Self::eval`].
     ///
     /// `incoming_dir` is the unit direction light travels before scattering; `u` holds three
-    /// uniform numbers in [0, 1): `u.x` picks the lobe by weight, `u.y` the scattering angle by
-    /// inverting that lobe's CDF, `u.z` the azimuth. Returns a unit vector.
+    /// uniform numbers in [0, 1): `u.x` picks the lobe by weight ([`Self::lobe_for`]), `u.y` the
+    /// scattering angle by inverting that lobe's CDF, `u.z` the azimuth. Returns a unit vector.
     pub fn sample(&self, incoming_dir: Vec3, u: Vec3) -> Vec3 {
-        let uniform = f64::from(u.y);
-        let (g, s) = if u.x < self.w_draine {
-            let g = f64::from(self.g_draine);
-            (g, sample_draine_s(g, f64::from(self.alpha), uniform))
+        self.sample_lobe(self.lobe_for(u.x), incoming_dir, glam::Vec2::new(u.y, u.z))
+    }
+
+    /// The lobe [`Self::sample`] draws from for the uniform number `u` in [0, 1): the Draine lobe
+    /// with probability `w_draine`.
+    pub fn lobe_for(&self, u: f32) -> Lobe {
+        if u < self.w_draine {
+            Lobe::Draine
         } else {
-            let g = f64::from(self.g_hg);
-            (g, sample_hg_s(g, uniform))
+            Lobe::HenyeyGreenstein
+        }
+    }
+
+    /// Weight of `lobe` in the mixture, 0..1.
+    pub fn lobe_weight(&self, lobe: Lobe) -> f32 {
+        match lobe {
+            Lobe::Draine => self.w_draine,
+            Lobe::HenyeyGreenstein => 1.0 - self.w_draine,
+        }
+    }
+
+    /// Density of `lobe` alone (normalised over the sphere) for the scattering cosine
+    /// `cos_theta`; [`Self::eval`] is the weighted sum of the two.
+    pub fn lobe_eval(&self, lobe: Lobe, cos_theta: f32) -> f32 {
+        let mu = f64::from(cos_theta);
+        let value = match lobe {
+            Lobe::Draine => draine_f64(f64::from(self.g_draine), f64::from(self.alpha), mu),
+            Lobe::HenyeyGreenstein => hg_f64(f64::from(self.g_hg), mu),
+        };
+        value as f32
+    }
+
+    /// Samples a direction from `lobe` alone, distributed as [`Self::lobe_eval`]: `u.x` inverts
+    /// the lobe's CDF, `u.y` picks the azimuth.
+    pub fn sample_lobe(&self, lobe: Lobe, incoming_dir: Vec3, u: glam::Vec2) -> Vec3 {
+        let uniform = f64::from(u.x);
+        let (g, s) = match lobe {
+            Lobe::Draine => {
+                let g = f64::from(self.g_draine);
+                (g, sample_draine_s(g, f64::from(self.alpha), uniform))
+            }
+            Lobe::HenyeyGreenstein => {
+                let g = f64::from(self.g_hg);
+                (g, sample_hg_s(g, uniform))
+            }
         };
         let (cos_theta, sin_theta) = cos_sin_from_s(g, s);
         rotate_about(
             incoming_dir,
             cos_theta as f32,
             sin_theta as f32,
-            std::f32::consts::TAU * u.z,
+            std::f32::consts::TAU * u.y,
         )
     }
 

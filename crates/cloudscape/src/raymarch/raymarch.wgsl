@@ -197,20 +197,9 @@ fn march_ray_offset(px: vec2<u32>) -> f32 {
     return fract(frame.ray_offset_strata + MARCH_BAYER_3X3[(px.x % 3u) * 3u + px.y % 3u] / 9.0);
 }
 
-// Where sample `index` of `spp` crosses its pixel: the centre for one sample, else the R2
-// sequence (Roberts 2018, "The unreasonable effectiveness of quasirandom sequences": the additive
-// recurrence by the inverse plastic number), so the samples integrate the pixel's footprint as the
-// path tracer's do.
-fn march_subpixel(index: u32, spp: u32) -> vec2<f32> {
-    if spp <= 1u {
-        return vec2<f32>(0.5);
-    }
-    return fract(vec2<f32>(0.5) + f32(index) * vec2<f32>(0.7548776662, 0.5698402910));
-}
-
 // One sample of one ray per texel of the output grid (1/divisor of the frame's resolution), through
 // the sub-pixel of its block the frame's grid names. With several samples per pixel the pass is
-// dispatched once per sample, each through its own point of the pixel (march_subpixel), and sums
+// dispatched once per sample, each through its own point of the pixel (frame_footprint_point), and sums
 // them in `march_sums`: llvmpipe caps the loop iterations of one invocation at 65535 in total
 // (LP_MAX_TGSI_LOOP_ITERATIONS, Mesa gallivm), which long grazing rays times several samples
 // exceed, and short invocations suit GPUs as well. The last sample writes radiance and
@@ -231,7 +220,7 @@ fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     if spp > 1u {
         sample_index = march_sums[slot].samples;
     }
-    let pixel = vec2<f32>(full_px) + march_subpixel(sample_index, spp);
+    let pixel = vec2<f32>(full_px) + frame_footprint_point(sample_index, spp);
     let o = frame.camera_position_m;
     let d = frame_ray_direction(pixel);
     let depth = frame_block_depth(host_depth, px, divisor);

@@ -14,7 +14,7 @@ use crate::gpu::pipeline::{clear_depth, texture_2d};
 use crate::gpu::{GpuContext, PassTimer, readback};
 use crate::image::{HdrImage, LdrImage};
 use crate::post::{Background, HDR_FORMAT};
-use crate::scene::Scene;
+use crate::scene::{Scene, Technique};
 use crate::technique::TechniqueStats;
 use glam::UVec2;
 use std::path::Path;
@@ -151,13 +151,56 @@ impl SceneRenderer {
 
     /// Renders the scene as it describes itself (its frame, size, steps, exposure), calling
     /// `progress` with the fraction done after each band of rows.
+    ///
+    /// The ray marcher spreads its `render.samples_per_pixel` over each pixel itself. The
+    /// rasterising techniques (particles, sprites) draw the whole frame once per sample, each
+    /// through its own point of the pixel ([`Frame::footprint_point`], a sub-pixel shift of the
+    /// projection), and the HDR frames are averaged: the pixel's footprint, as the path tracer
+    /// integrates it.
     pub fn render(&mut self, ctx: &GpuContext, mut progress: impl FnMut(f32)) -> Rendered {
         let render = &self.scene.render;
-        let size = UVec2::new(render.width, render.height);
-        let frame = Frame::from_scene(&self.scene, size);
-        self.host(ctx, &frame);
+        let frame = Frame::from_scene(&self.scene, UVec2::new(render.width, render.height));
+        let samples = match render.technique {
+            Technique::Raymarch => 1,
+            Technique::Particles | Technique::Sprites => render.samples_per_pixel.unwrap_or(1),
+        };
+        if samples <= 1 {
+            return self.render_in_bands(ctx, &frame, &mut progress);
+        }
+        let (exposure_ev, tonemap) = (render.exposure_ev, render.tonemap);
+        let mut sum = HdrImage::new(frame.size.x, frame.size.y);
+        for index in 0..samples {
+            let shifted = Frame {
+                frame_index: index,
+                ..frame.shifted_by(Frame::footprint_point(index, samples) - 0.5)
+            };
+            let done = index as f32;
+            let hdr = self
+                .render_in_bands(ctx, &shifted, &mut |f| {
+                    progress((done + f) / samples as f32)
+                })
+                .hdr;
+            for (total, pixel) in sum.pixels.iter_mut().zip(&hdr.pixels) {
+                for (t, p) in total.iter_mut().zip(pixel) {
+                    *t += p / samples as f32;
+                }
+            }
+        }
+        let ldr = sum.to_ldr(exposure_ev, tonemap);
+        Rendered { hdr: sum, ldr }
+    }
+
+    /// Renders `frame` in bands of [`TILE_ROWS`] output rows, one submission each, calling
+    /// `progress` with the fraction done after each.
+    fn render_in_bands(
+        &mut self,
+        ctx: &GpuContext,
+        frame: &Frame,
+        progress: &mut dyn FnMut(f32),
+    ) -> Rendered {
+        self.host(ctx, frame);
         let host = self.host.as_ref().expect("made above");
-        self.clouds.begin_frame(ctx, &frame, Reuse::None);
+        self.clouds.begin_frame(ctx, frame, Reuse::None);
         let output = self.clouds.output_size();
         for row in (0..output.y).step_by(TILE_ROWS as usize) {
             let band = (
