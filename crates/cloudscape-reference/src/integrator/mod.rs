@@ -166,8 +166,8 @@ impl<M: Medium> PathTracer<M> {
             // broad part (see [`sun`]).
             let first = order == 0;
             let sun = self.sun_light(vertex, first, rng);
-            let chain = self.peak_chain(vertex, (first, orders - order - 1), rng);
-            radiance += throughput * (sun + chain + self.sky_light(vertex, rng));
+            let chain = self.peak_chain(vertex, (first, orders - order - 1, &sun), rng);
+            radiance += throughput * (sun.radiance + chain + self.sky_light(vertex, rng));
             let next = self.continue_from(vertex, rng);
             throughput *= next.weight;
             if !roulette(&mut throughput, rng) {

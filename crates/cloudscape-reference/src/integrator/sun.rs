@@ -19,9 +19,11 @@
 //!   or its continuation leaving through the disc, weighed against each other by the power
 //!   heuristic (Veach 1997, section 9.2);
 //! - a run that follows a broad scattering (or a ground bounce) at vertex `x`: the forward-peak
-//!   chain at `x` ([`PathTracer::peak_chain`]), which draws a direction from a lobe about the sun,
+//!   chain at `x` ([`PathTracer::peak_chain`]), which draws a direction from a lobe about the sun
+//!   (one time in five as the scattering at `x` draws it, so that its weight stays bounded),
 //!   follows it to a collision and from there walks the peak lobe alone, estimating the sun at
-//!   every vertex of the run;
+//!   every vertex of the run; deep in a cloud, where the disc's estimate finds the sun nearly
+//!   hidden, it runs only now and then, weighted by the inverse of its chance;
 //! - a run that takes in the camera's first vertex (every scattering in the peak, as when the
 //!   camera looks near the sun through a cloud): the chain at the first vertex when the run goes
 //!   on past it, else the first vertex's disc estimate or its leaving continuation.
@@ -47,30 +49,30 @@ use std::f32::consts::PI;
 /// few peak scatterings spread the beam into.
 const CHAIN_FIRST_G: f32 = 0.992;
 
+/// Share of the chain's first directions drawn as the scattering at its vertex draws them (a
+/// defensive mixture, Hesterberg 1995): the lobe about the sun alone leaves directions far from
+/// the sun with a density far below the broad lobe's weight there, and a chain that starts there
+/// and turns toward the sun through the peak's tail was a firefly of 30,000 times its pixel; with
+/// the mixture the first weight is at most `1 / CHAIN_OWN_SHARE`.
+const CHAIN_OWN_SHARE: f32 = 0.2;
+
 impl<M: Medium> PathTracer<M> {
     /// Next-event estimate of the sun's light scattered at `vertex` toward the path: one
     /// direction uniform over the disc, through the broad part of the scattering, and through the
     /// peak part too at the path's `first` vertex.
-    pub(super) fn sun_light(&self, vertex: Vertex, first: bool, rng: &mut Rng) -> Vec3 {
-        let Some(sun) = self.environment.sun else {
-            return Vec3::ZERO;
-        };
-        let dir = crate::sampling::uniform_cone(sun.direction, sun.cos_radius, rng.next_vec2());
-        let disc_pdf = sun_disc_pdf(&sun);
-        let weighted = |part: Part| {
-            let (value, pdf) = self.part_scattering(vertex, part, dir);
-            value * disc_weight(disc_pdf, pdf)
-        };
-        let mut scattering = weighted(Part::Broad);
-        if first {
-            scattering += weighted(Part::Peak);
-        }
-        if scattering.max_element() <= 0.0 {
-            return Vec3::ZERO;
-        }
-        let p = position(vertex);
-        // Uniform over the disc: radiance E / Omega over density 1 / Omega leaves E.
-        self.environment.sun_irradiance(p) * scattering * self.visibility(p, dir, rng)
+    pub(super) fn sun_light(&self, vertex: Vertex, first: bool, rng: &mut Rng) -> DiscEstimate {
+        self.disc_light(vertex, rng, |dir, disc_pdf| {
+            let weighted = |part: Part| {
+                let (value, pdf) = self.part_scattering(vertex, part, dir);
+                value * disc_weight(disc_pdf, pdf)
+            };
+            let broad = weighted(Part::Broad);
+            if first {
+                broad + weighted(Part::Peak)
+            } else {
+                broad
+            }
+        })
     }
 
     /// The sun disc's radiance seen by the continuation `next` that left the medium from
@@ -85,11 +87,12 @@ impl<M: Medium> PathTracer<M> {
 
     /// The forward-peak chain from `vertex`: the sunlight that reaches it after a run of peak
     /// scatterings following its scattering (the broad part; the whole of it at the path's
-    /// `first` vertex), at most `orders_left` of them.
+    /// `first` vertex), at most `orders_left` of them. `toward_sun` is what the disc's estimate
+    /// at `vertex` found ([`Self::chain_probability`]).
     pub(super) fn peak_chain(
         &self,
         vertex: Vertex,
-        (first, orders_left): (bool, u32),
+        (first, orders_left, toward_sun): (bool, u32, &DiscEstimate),
         rng: &mut Rng,
     ) -> Vec3 {
         let Some(sun) = self.environment.sun else {
@@ -98,9 +101,18 @@ impl<M: Medium> PathTracer<M> {
         if orders_left == 0 || !self.has_peak() {
             return Vec3::ZERO;
         }
-        let lobe = PhaseLobes::henyey_greenstein(CHAIN_FIRST_G);
-        let mut dir = lobe.sample(sun.direction, rng.next_vec3());
-        let first_pdf = henyey_greenstein(CHAIN_FIRST_G, sun.direction.dot(dir));
+        let chance = self.chain_probability(first, toward_sun.transmittance);
+        if chance < 1.0 && rng.next_f32() >= chance {
+            return Vec3::ZERO;
+        }
+        let mut dir = if rng.next_f32() < CHAIN_OWN_SHARE {
+            self.own_direction(vertex, first, rng.next_vec3())
+        } else {
+            PhaseLobes::henyey_greenstein(CHAIN_FIRST_G).sample(sun.direction, rng.next_vec3())
+        };
+        let first_pdf = (1.0 - CHAIN_OWN_SHARE)
+            * henyey_greenstein(CHAIN_FIRST_G, sun.direction.dot(dir))
+            + CHAIN_OWN_SHARE * self.own_pdf(vertex, first, dir);
         let mut value = self.part_scattering(vertex, Part::Broad, dir).0;
         if first {
             value += self.part_scattering(vertex, Part::Peak, dir).0;
@@ -108,7 +120,7 @@ impl<M: Medium> PathTracer<M> {
         if value.max_element() <= 0.0 || first_pdf <= 0.0 {
             return Vec3::ZERO;
         }
-        let scale = value / first_pdf;
+        let scale = value / (first_pdf * chance);
         // Throughput relative to `scale`, so that roulette plays on how far the chain has faded.
         let mut relative = Vec3::ONE;
         let mut origin = position(vertex);
@@ -130,7 +142,7 @@ impl<M: Medium> PathTracer<M> {
                 dir,
             };
             relative *= self.albedo;
-            radiance += relative * self.peak_sun_light(collision, rng);
+            radiance += relative * self.peak_sun_light(collision, rng).radiance;
             let next = self
                 .phase
                 .sample_lobe(Lobe::HenyeyGreenstein, dir, rng.next_vec2());
@@ -145,27 +157,106 @@ impl<M: Medium> PathTracer<M> {
         scale * radiance
     }
 
+    /// The chain's defensive first direction at `vertex`, drawn as the scattering it is weighted
+    /// by: the whole phase function at the path's `first` vertex, the broad lobe after it, the
+    /// cosine on the ground.
+    fn own_direction(&self, vertex: Vertex, first: bool, u: Vec3) -> Vec3 {
+        match vertex {
+            Vertex::Medium { dir, .. } if first => self.phase.sample(dir, u),
+            Vertex::Medium { dir, .. } => {
+                self.phase
+                    .sample_lobe(Lobe::Draine, dir, glam::Vec2::new(u.y, u.z))
+            }
+            Vertex::Ground(g) => {
+                crate::sampling::cosine_hemisphere(g.normal, glam::Vec2::new(u.y, u.z))
+            }
+        }
+    }
+
+    /// Density of [`Self::own_direction`] for `next`.
+    fn own_pdf(&self, vertex: Vertex, first: bool, next: Vec3) -> f32 {
+        match vertex {
+            Vertex::Medium { dir, .. } if first => self.phase.eval(dir.dot(next)),
+            Vertex::Medium { dir, .. } => self.phase.lobe_eval(Lobe::Draine, dir.dot(next)),
+            Vertex::Ground(_) => self.scattering(vertex, next).1,
+        }
+    }
+
     /// The disc's next-event estimate at a vertex of the chain, through the peak part alone.
-    fn peak_sun_light(&self, vertex: Vertex, rng: &mut Rng) -> Vec3 {
+    fn peak_sun_light(&self, vertex: Vertex, rng: &mut Rng) -> DiscEstimate {
+        let Vertex::Medium { dir: before, .. } = vertex else {
+            return DiscEstimate::NONE;
+        };
+        self.disc_light(vertex, rng, |dir, disc_pdf| {
+            let (value, _) = self.part_scattering(vertex, Part::Peak, dir);
+            let lobe_pdf = self
+                .phase
+                .lobe_eval(Lobe::HenyeyGreenstein, before.dot(dir));
+            value * disc_weight(disc_pdf, lobe_pdf)
+        })
+    }
+
+    /// Next-event estimate of the sun at `vertex` by one direction uniform over its disc:
+    /// `scattering(dir, disc density)` is the weighted scattering factor toward it.
+    fn disc_light(
+        &self,
+        vertex: Vertex,
+        rng: &mut Rng,
+        scattering: impl Fn(Vec3, Option<f32>) -> Vec3,
+    ) -> DiscEstimate {
         let Some(sun) = self.environment.sun else {
-            return Vec3::ZERO;
+            return DiscEstimate::NONE;
         };
         let dir = crate::sampling::uniform_cone(sun.direction, sun.cos_radius, rng.next_vec2());
-        let (value, _) = self.part_scattering(vertex, Part::Peak, dir);
-        let Vertex::Medium { dir: before, .. } = vertex else {
-            return Vec3::ZERO;
-        };
-        let lobe_pdf = self
-            .phase
-            .lobe_eval(Lobe::HenyeyGreenstein, before.dot(dir));
-        let weight = disc_weight(sun_disc_pdf(&sun), lobe_pdf);
-        if value.max_element() <= 0.0 || weight <= 0.0 {
-            return Vec3::ZERO;
+        let value = scattering(dir, sun_disc_pdf(&sun));
+        if value.max_element() <= 0.0 {
+            return DiscEstimate::NONE;
         }
         let p = position(vertex);
-        self.environment.sun_irradiance(p) * value * (weight * self.visibility(p, dir, rng))
+        let transmittance = self.visibility(p, dir, rng);
+        DiscEstimate {
+            // Uniform over the disc: radiance E / Omega over density 1 / Omega leaves E.
+            radiance: self.environment.sun_irradiance(p) * value * transmittance,
+            transmittance: Some(transmittance),
+        }
+    }
+
+    /// Probability of running the chain from a vertex: 1 at the path's `first` vertex, else
+    /// `T^(1 - w) / 0.1` within [[`CHAIN_MIN_PROBABILITY`], 1], where `T` is the disc's estimate
+    /// of the transmittance toward the sun there and `w` the peak's weight: `T^(1 - w)` is about
+    /// what the peak-scattered beam keeps (it fades with the δ-scaled optical depth), so the deep
+    /// vertices of long diffusion paths, whose chains find little, run one in ten (weighted by
+    /// the inverse, so the estimate stays unbiased: Russian roulette, Arvo & Kirk 1990).
+    fn chain_probability(&self, first: bool, transmittance: Option<f32>) -> f32 {
+        match (first, transmittance) {
+            (false, Some(t)) => {
+                let keeps = t.powf(1.0 - self.phase.lobe_weight(Lobe::HenyeyGreenstein));
+                (keeps / 0.1).clamp(CHAIN_MIN_PROBABILITY, 1.0)
+            }
+            _ => 1.0,
+        }
     }
 }
+
+/// A next-event estimate of the sun, and the transmittance toward it that it traced (None where
+/// nothing scatters toward the sun, so nothing was traced).
+pub(super) struct DiscEstimate {
+    /// The sunlight scattered toward the path.
+    pub radiance: Vec3,
+    /// The ratio-tracked transmittance toward the sampled point of the disc.
+    pub transmittance: Option<f32>,
+}
+
+impl DiscEstimate {
+    /// No light, nothing traced.
+    const NONE: DiscEstimate = DiscEstimate {
+        radiance: Vec3::ZERO,
+        transmittance: None,
+    };
+}
+
+/// Smallest probability of running the forward-peak chain from a vertex after the first.
+const CHAIN_MIN_PROBABILITY: f32 = 0.1;
 
 impl<M: Medium> PathTracer<M> {
     /// At `vertex`, for leaving toward `next`: the `part` of the scattering factor (phase

@@ -900,8 +900,10 @@ pub struct RenderSettings {
     pub primary_steps: Option<u32>,
     /// Overrides the preset's steps toward the sun per sample, 1..64.
     pub light_steps: Option<u32>,
-    /// Overrides the preset's jittered passes averaged per pixel, 1..1024; each crosses the pixel at
-    /// its own point, so several integrate the pixel's footprint (anti-aliasing).
+    /// Samples per pixel, 1..1024, each crossing the pixel at its own point, so several integrate
+    /// the pixel's footprint (anti-aliasing): the ray marcher's jittered passes (its preset's by
+    /// default); the particles and sprites draw the whole frame once per sample and average them
+    /// ([`crate::renderer::SceneRenderer::render`]; 1 by default).
     pub samples_per_pixel: Option<u32>,
     /// Skip the empty space above the clouds with the hierarchical height map (same image, less
     /// work). On by default.
