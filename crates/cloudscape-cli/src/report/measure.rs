@@ -157,10 +157,11 @@ pub fn measure(
 }
 
 impl Measurement {
-    /// Writes the tone-mapped image to `image` and the HDR-FLIP map against `reference` to
-    /// `flip`.
+    /// Writes the tone-mapped image to `image`, the HDR radiance beside it as EXR, and the
+    /// HDR-FLIP map against `reference` to `flip`.
     pub fn write_images(&self, reference: &HdrImage, image: &Path, flip: &Path) -> Result<()> {
         self.rendered.ldr.write_png(image)?;
+        self.rendered.hdr.write_exr(&image.with_extension("exr"))?;
         Comparison::of(reference, &self.rendered.hdr, Some(flip))?;
         Ok(())
     }

@@ -210,9 +210,6 @@ fn scene_row(
         match variant.technique {
             Technique::Raymarch => {
                 m.write_images(&full, &image_path("raymarch"), &image_path("flip"))?;
-                m.rendered
-                    .hdr
-                    .write_exr(&images.join(format!("{name}-raymarch.exr")))?;
                 raymarch = Some(m.comparison.clone());
                 raymarch_regions = Some(regions::RegionErrors::of(
                     &full,
