@@ -25,6 +25,7 @@ mod atmosphere_passes;
 mod gpu;
 mod passes;
 mod shadow_pass;
+pub mod light_volume;
 mod table_pass;
 
 pub use atmosphere_passes::{ATMOSPHERE_AERIAL_WGSL, ATMOSPHERE_LUTS_WGSL, ATMOSPHERE_MARCH_WGSL};

@@ -59,7 +59,7 @@ impl MarchSettings {
     pub fn back_steps(&self) -> u32 {
         match self.model {
             LightingModel::Slab => back_steps(self.light_steps),
-            LightingModel::Octaves => 0,
+            LightingModel::Octaves | LightingModel::Volume => 0,
         }
     }
 
@@ -136,6 +136,7 @@ impl MarchUniform {
             lighting_model: match settings.model {
                 LightingModel::Slab => 0,
                 LightingModel::Octaves => 1,
+                LightingModel::Volume => 2,
             },
             back_steps: settings.back_steps(),
             slab_params: Vec4::from_array(settings.slab.params_to_gpu()),

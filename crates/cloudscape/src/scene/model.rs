@@ -527,6 +527,10 @@ impl crate::optics::PhaseLobes {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, DocumentedVariants)]
 #[serde(rename_all = "snake_case")]
 pub enum LightingModel {
+    /// The light volume: the δ-Eddington equations solved in 3-D on grids that follow the camera
+    /// (`environment::light_volume`), read for the diffuse light; single scattering and the
+    /// forward peak per sample as with the slab.
+    Volume,
     /// The δ-Eddington solution of a slab along the sun, from the optical depths toward the sun
     /// and away from it (`optics::slab`).
     Slab,
@@ -565,6 +569,22 @@ pub struct Lighting {
     pub octave_eccentricity: f32,
     /// Scale of the light scattered from the sky and the ground into the cloud, 0..4.
     pub ambient_scale: f32,
+    /// Light volume: cells of each cascade along x and z, 8..256.
+    pub volume_cells_horizontal: u32,
+    /// Light volume: cells through the clouds' heights, 4..64.
+    pub volume_cells_vertical: u32,
+    /// Light volume: half width of the finest cascade, metres; each next one reaches 4 times as
+    /// far.
+    pub volume_extent_m: f32,
+    /// Light volume: cascades, 1..4.
+    pub volume_cascades: u32,
+    /// Light volume: relaxation sweeps when the grid is new or has moved, 1..256.
+    pub volume_sweeps: u32,
+    /// Light volume: sweeps per frame while the grid stays put (warm-started from the last
+    /// frame), 0..64.
+    pub volume_warm_sweeps: u32,
+    /// Light volume: samples of the coarse field toward the sun per cell, 4..64.
+    pub volume_beam_steps: u32,
 }
 
 impl Lighting {
@@ -593,7 +613,7 @@ impl Default for Lighting {
     fn default() -> Self {
         Lighting {
             albedo: 1.0,
-            model: LightingModel::Slab,
+            model: LightingModel::Volume,
             slab_diffuse_scale: 0.613,
             slab_back_scale: 1.422,
             octaves: 6,
@@ -601,6 +621,13 @@ impl Default for Lighting {
             octave_contribution: 0.7,
             octave_eccentricity: 0.7,
             ambient_scale: 1.0,
+            volume_cells_horizontal: 48,
+            volume_cells_vertical: 24,
+            volume_extent_m: 8000.0,
+            volume_cascades: 2,
+            volume_sweeps: 32,
+            volume_warm_sweeps: 4,
+            volume_beam_steps: 24,
         }
     }
 }

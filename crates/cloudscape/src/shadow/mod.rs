@@ -206,7 +206,7 @@ impl BuiltShadow {
     }
 }
 
-fn cloud_heights(field: &CloudField) -> (f32, f32, bool) {
+pub(crate) fn cloud_heights(field: &CloudField) -> (f32, f32, bool) {
     let layers = field.altitude_range_m();
     let volumes = field
         .volumes

@@ -160,7 +160,7 @@ listed! {
     PlanetShape { Spherical, Flat }
     WeatherSource { Procedural, File }
     PhaseModel { Mie, Hg, DualHg }
-    LightingModel { Slab, Octaves }
+    LightingModel { Volume, Slab, Octaves }
     ParticleStyle { Smooth, Thresholded, Pyroclastic }
     TableResolution { Low, Standard, High }
     ParticleBlending { VolumeAware, Alpha }
