@@ -135,5 +135,10 @@ pub trait Technique {
     fn finish_frame(&mut self, encoder: &mut wgpu::CommandEncoder);
 
     /// The statistics of the newest frame the GPU has finished (never waits; None before any).
+    /// Whether the technique reads the environment's light volume (the frame solves it then).
+    fn reads_light_volume(&self) -> bool {
+        false
+    }
+
     fn stats(&mut self, ctx: &GpuContext) -> Option<TechniqueStats>;
 }

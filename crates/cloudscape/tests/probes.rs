@@ -831,3 +831,61 @@ fn particle_blending_and_sprite_levels_match_the_cpu() {
     let want: Vec<Vec4> = inputs.iter().map(|p| level_at(&levels, p.d.y)).collect();
     assert_close("sprite levels", &got, &want, 1e-5);
 }
+
+/// The light volume solved on the GPU (its cells, its sweeps, its table) and read by
+/// `environment_light_volume_diffuse`, against the CPU solve read by `LightVolume::diffuse`, at
+/// points through both cascades and the sky around them, in several directions. The GPU stores
+/// the table in f16 and filters it with its own weights: 3 % of the largest value.
+#[test]
+fn the_light_volume_matches_the_cpu() {
+    use cloudscape::environment::light_volume::inputs::VolumeLight;
+    use cloudscape::environment::light_volume::{
+        DiffuseOptics, LightVolume, LightVolumeGrid, LightVolumeSettings,
+    };
+    let ctx = GpuContext::for_tests();
+    let mut scene = Scene::default();
+    scene.layers[0].coverage = 0.6;
+    let l = &mut scene.lighting;
+    (l.volume_cells_horizontal, l.volume_cells_vertical) = (16, 12);
+    (l.volume_extent_m, l.volume_sweeps) = (3000.0, 12);
+    let frame = Frame::from_scene(&scene, SIZE);
+    let clouds = renderer(&ctx, &scene, &frame);
+    let settings = LightVolumeSettings::from_scene(&scene);
+    let grid = LightVolumeGrid::new(&settings, clouds.field(), frame.camera_position_m);
+    let env = Environment::from_scene(&scene);
+    let viewed = ViewedEnvironment::new(&env, frame.camera_position_m);
+    let light = VolumeLight {
+        environment: &viewed,
+        ground_albedo: FrameSettings::from_scene(&scene).ground_albedo,
+        time_s: frame.time_s,
+    };
+    let optics = DiffuseOptics::of(&scene.lighting.sun_slab(PhaseLobes::from_scene(&scene.phase)));
+    let volume = LightVolume::solve(&grid, &settings, (clouds.field(), optics), &light);
+    let (low, high) = (grid.cascades[0].min_m.y, grid.cascades[0].min_m.y + 1500.0);
+    let inputs: Vec<ProbeInput> = (0..240)
+        .map(|i| {
+            let reach = if i % 3 == 0 { 12_000.0 } else { 3000.0 };
+            let p = frame.camera_position_m
+                + Vec3::new(
+                    reach * (2.0 * unit(i, 41) - 1.0),
+                    0.0,
+                    reach * (2.0 * unit(i, 42) - 1.0),
+                );
+            let p = Vec3::new(p.x, low + (high - low) * unit(i, 43), p.z);
+            input(p.extend(0.0), direction(i, -1.0).extend(0.0))
+        })
+        .collect();
+    let got = gpu(&ctx, &clouds, ProbeFunction::LightVolumeDiffuse, &inputs);
+    let want: Vec<Vec3> = inputs
+        .iter()
+        .map(|i| volume.diffuse(i.a.truncate(), i.b.truncate()))
+        .collect();
+    let scale = want.iter().map(|w| w.max_element()).fold(0.0, f32::max);
+    assert!(scale > 0.0, "the volume holds light");
+    for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+        let error = (g.truncate() - *w).abs().max_element() / scale;
+        assert!(error <= 0.03, "#{i} at {}: GPU {g} vs CPU {w}", inputs[i].a);
+    }
+    let lit = want.iter().filter(|w| w.max_element() > 0.1 * scale).count();
+    assert!(lit > 40, "most points see diffuse light ({lit})");
+}

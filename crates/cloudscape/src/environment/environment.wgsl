@@ -16,6 +16,18 @@ struct CloudShadow {
     pad: vec2<u32>,
 }
 
+// The light volume's cascades (environment/light_volume, LightVolumeUniform).
+struct LightVolume {
+    cascade_min_m: array<vec4<f32>, LIGHT_VOLUME_MAX_CASCADES>,  // lowest corner (xyz) of each
+    cascade_cell_m: array<vec4<f32>, LIGHT_VOLUME_MAX_CASCADES>, // cell size (xyz) of each
+    cells: vec3<u32>,          // cells of each cascade along x, y (up) and z
+    cascades: u32,
+    optics: vec4<f32>,         // DiffuseOptics::to_gpu: scaled albedo, scaled g, thinning, g
+    enabled: u32,              // 0: no clouds, the volume reads zero
+    beam_steps: u32,           // samples of the coarse field toward the sun per cell
+    pad: vec2<u32>,
+}
+
 struct Environment {
     sun_direction: vec3<f32>,       // unit vector toward the sun
     sun_cos_angular_radius: f32,    // cosine of the sun disc's angular radius
@@ -29,6 +41,7 @@ struct Environment {
     sun_limb_darkening: f32,        // linear limb-darkening coefficient u of the sun's disc
     air: Air,
     shadow: CloudShadow,
+    light_volume: LightVolume,
 }
 
 @group(2) @binding(0) var<uniform> environment: Environment;
@@ -36,9 +49,11 @@ struct Environment {
 @group(2) @binding(2) var environment_multiple_scattering: texture_2d<f32>;
 @group(2) @binding(3) var environment_irradiance: texture_2d_array<f32>;
 @group(2) @binding(4) var environment_sky_view: texture_2d<f32>;
-@group(2) @binding(5) var environment_aerial_inscatter: texture_2d<f32>;     // atlas of slices
-@group(2) @binding(6) var environment_aerial_transmittance: texture_2d<f32>; // atlas of slices
-@group(2) @binding(7) var environment_cloud_shadow: texture_2d_array<f32>;
+// Atlases of slices: in-scattering (layer 0) and transmittance (layer 1).
+@group(2) @binding(5) var environment_aerial: texture_2d_array<f32>;
+@group(2) @binding(6) var environment_cloud_shadow: texture_2d_array<f32>;
+// The light volume: I0 of each cascade side by side along z, then J / I0 (luminance) the same way.
+@group(2) @binding(7) var environment_light_volume: texture_3d<f32>;
 @group(2) @binding(8) var environment_linear: sampler;
 
 // Unit vector toward the sun.
@@ -202,8 +217,8 @@ fn environment_aerial_perspective(radiance: vec3<f32>, coverage: f32, uv: vec2<f
     let k1 = min(k0 + 1.0, f32(ATMOSPHERE_AERIAL_SLICES - 1u));
     let a = environment_aerial_texel_uv(uv, k0);
     let b = environment_aerial_texel_uv(uv, k1);
-    var inscatter = mix(textureSampleLevel(environment_aerial_inscatter, environment_linear, a, 0.0).rgb, textureSampleLevel(environment_aerial_inscatter, environment_linear, b, 0.0).rgb, w - k0);
-    var transmittance = mix(textureSampleLevel(environment_aerial_transmittance, environment_linear, a, 0.0).rgb, textureSampleLevel(environment_aerial_transmittance, environment_linear, b, 0.0).rgb, w - k0);
+    var inscatter = mix(textureSampleLevel(environment_aerial, environment_linear, a, 0, 0.0).rgb, textureSampleLevel(environment_aerial, environment_linear, b, 0, 0.0).rgb, w - k0);
+    var transmittance = mix(textureSampleLevel(environment_aerial, environment_linear, a, 1, 0.0).rgb, textureSampleLevel(environment_aerial, environment_linear, b, 1, 0.0).rgb, w - k0);
     let near = clamp(slices, 0.0, 1.0);
     inscatter *= near;
     transmittance = mix(vec3<f32>(1.0), transmittance, near);
@@ -275,4 +290,33 @@ fn environment_cloud_sky_optical_depth(p: vec3<f32>) -> f32 {
 // exp(-tau) (Beer-Lambert) from the shared map: the shadow a host's geometry receives.
 fn environment_cloud_sun_transmittance(p: vec3<f32>) -> f32 {
     return exp(-environment_cloud_sun_optical_depth(p));
+}
+
+// Texture coordinates of world point p in the light volume's radiance (its current lies half the
+// texture further along z): the finest cascade holding p (within half a cell of its sides), else
+// the coarsest, clamped to its cells' centres so that no neighbouring cascade bleeds in.
+fn environment_light_volume_uvw(p: vec3<f32>) -> vec3<f32> {
+    let v = environment.light_volume;
+    let n = vec3<f32>(v.cells);
+    var k = v.cascades - 1u;
+    for (var c = v.cascades; c > 0u; c--) {
+        let local = (p - v.cascade_min_m[c - 1u].xyz) / v.cascade_cell_m[c - 1u].xyz;
+        let inside = all(local.xz >= vec2<f32>(0.5)) && all(local.xz <= n.xz - 0.5);
+        k = select(k, c - 1u, inside);
+    }
+    let local = clamp((p - v.cascade_min_m[k].xyz) / v.cascade_cell_m[k].xyz, vec3<f32>(0.5), n - 0.5);
+    return vec3<f32>(local.x / n.x, local.y / n.y, (local.z + n.z * f32(k)) / (2.0 * n.z * f32(v.cascades)));
+}
+
+// The diffuse light of the clouds at world point p scattered toward the eye along `toward_eye`
+// (unit), per unit scattering coefficient: I0 + g w . I1 of the light volume's δ-Eddington
+// solution, with I1 = 3 J (optics/slab.rs scatters its slab's diffuse field the same way). Zero
+// without a volume.
+fn environment_light_volume_diffuse(p: vec3<f32>, toward_eye: vec3<f32>) -> vec3<f32> {
+    let uvw = environment_light_volume_uvw(p);
+    let radiance = textureSampleLevel(environment_light_volume, environment_linear, uvw, 0.0).rgb;
+    let current = textureSampleLevel(environment_light_volume, environment_linear, uvw + vec3<f32>(0.0, 0.0, 0.5), 0.0).xyz;
+    let g = environment.light_volume.optics.w;
+    let diffuse = radiance * max(1.0 + 3.0 * g * dot(current, toward_eye), 0.0);
+    return select(vec3<f32>(0.0), diffuse, environment.light_volume.enabled == 1u);
 }

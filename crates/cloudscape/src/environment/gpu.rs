@@ -1,5 +1,5 @@
-//! The environment on the GPU: its uniform, the atmosphere's tables and the clouds' shadow map in
-//! one bind group ([`crate::shader::ENVIRONMENT_GROUP`]), as `environment.wgsl` declares them.
+//! The environment on the GPU: its uniform, the atmosphere's tables, the clouds' shadow map and
+//! the light volume in one bind group ([`crate::shader::ENVIRONMENT_GROUP`]), as `environment.wgsl` declares them.
 
 use super::{Environment, SkyModel};
 use crate::atmosphere::Air;
@@ -9,9 +9,10 @@ use crate::atmosphere::luts::{
 };
 use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{UNIFORM, bind_group, bind_group_layout, float_texture, uniform_buffer};
+use super::light_volume::{DiffuseOptics, LightVolumeGrid, LightVolumeSettings, MAX_CASCADES};
 use crate::shadow::ShadowParams;
 use bytemuck::{Pod, Zeroable};
-use glam::{Vec2, Vec3};
+use glam::{UVec3, Vec2, Vec3, Vec4};
 
 /// Format of every table: filterable everywhere, and storage-writable.
 pub const TABLE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -101,11 +102,50 @@ pub struct EnvironmentUniform {
     sun_limb_darkening: f32,
     air: AirUniform,
     shadow: CloudShadowUniform,
+    light_volume: LightVolumeUniform,
+}
+
+/// GPU layout of a frame's light volume ([`LightVolumeGrid`], [`DiffuseOptics`]): the
+/// `LightVolume` struct of `environment.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LightVolumeUniform {
+    cascade_min_m: [Vec4; MAX_CASCADES as usize],
+    cascade_cell_m: [Vec4; MAX_CASCADES as usize],
+    cells: UVec3,
+    cascades: u32,
+    optics: Vec4,
+    enabled: u32,
+    beam_steps: u32,
+    pad: [u32; 2],
+}
+
+impl LightVolumeUniform {
+    /// The volume of `grid` with `optics`, sampling the beam in `beam_steps`; zeros (read as no
+    /// diffuse light) for None.
+    pub fn new(volume: Option<(&LightVolumeGrid, DiffuseOptics, u32)>) -> LightVolumeUniform {
+        let mut out = LightVolumeUniform::zeroed();
+        let Some((grid, optics, beam_steps)) = volume else {
+            out.cells = UVec3::ONE;
+            out.cascades = 1;
+            return out;
+        };
+        for (k, c) in grid.cascades.iter().enumerate() {
+            out.cascade_min_m[k] = c.min_m.extend(0.0);
+            out.cascade_cell_m[k] = c.cell_m.extend(0.0);
+        }
+        out.cells = grid.cells;
+        out.cascades = grid.cascades.len() as u32;
+        out.optics = Vec4::from_array(optics.to_gpu());
+        out.enabled = u32::from(grid.enabled);
+        out.beam_steps = beam_steps;
+        out
+    }
 }
 
 impl EnvironmentUniform {
     /// The uniform of `env` seen from world point `viewpoint_m`, with the clouds' shadow map
-    /// `shadow`.
+    /// `shadow`, without a light volume ([`EnvironmentUniform::with_light_volume`]).
     pub fn new(env: &Environment, viewpoint_m: Vec3, shadow: &ShadowParams) -> EnvironmentUniform {
         EnvironmentUniform {
             sun_direction: env.sun.direction,
@@ -120,6 +160,15 @@ impl EnvironmentUniform {
             sun_limb_darkening: env.sun.limb_darkening,
             air: AirUniform::new(&env.air),
             shadow: CloudShadowUniform::new(shadow),
+            light_volume: LightVolumeUniform::new(None),
+        }
+    }
+
+    /// This uniform with the frame's light volume.
+    pub fn with_light_volume(self, light_volume: LightVolumeUniform) -> EnvironmentUniform {
+        EnvironmentUniform {
+            light_volume,
+            ..self
         }
     }
 }
@@ -136,21 +185,24 @@ pub enum EnvironmentTable {
     Irradiance,
     /// The sky seen from the viewpoint (binding 4).
     SkyView,
-    /// Aerial-perspective in-scattering and transmittance (bindings 5 and 6).
+    /// Aerial-perspective in-scattering and transmittance (binding 5, layers 0 and 1).
     Aerial,
-    /// The clouds' light-space optical depth (binding 7).
+    /// The clouds' light-space optical depth (binding 6).
     CloudShadow,
+    /// The light volume's diffuse radiance and current (binding 7, one above the other along z).
+    LightVolume,
 }
 
 impl EnvironmentTable {
     /// Every table, in binding order.
-    pub const ALL: [EnvironmentTable; 6] = [
+    pub const ALL: [EnvironmentTable; 7] = [
         EnvironmentTable::Transmittance,
         EnvironmentTable::MultipleScattering,
         EnvironmentTable::Irradiance,
         EnvironmentTable::SkyView,
         EnvironmentTable::Aerial,
         EnvironmentTable::CloudShadow,
+        EnvironmentTable::LightVolume,
     ];
 
     /// Bindings of the texture (or textures) of this table.
@@ -160,8 +212,9 @@ impl EnvironmentTable {
             EnvironmentTable::MultipleScattering => &[2],
             EnvironmentTable::Irradiance => &[3],
             EnvironmentTable::SkyView => &[4],
-            EnvironmentTable::Aerial => &[5, 6],
-            EnvironmentTable::CloudShadow => &[7],
+            EnvironmentTable::Aerial => &[5],
+            EnvironmentTable::CloudShadow => &[6],
+            EnvironmentTable::LightVolume => &[7],
         }
     }
 }
@@ -173,9 +226,43 @@ struct TableShape {
     dimension: wgpu::TextureViewDimension,
 }
 
-/// The shapes of bindings 1-7 for a shadow map of `shadow_texels` per side.
-fn shapes(shadow_texels: u32) -> [TableShape; 7] {
-    use wgpu::TextureViewDimension::{D2, D2Array};
+/// The sizes of the tables that follow the scene's settings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TableSizes {
+    /// Texels per side of the cloud shadow map.
+    pub shadow_texels: u32,
+    /// Cells of the light volume: one cascade's, the cascades side by side along z (the table
+    /// holds them twice along z: the radiance, then the current).
+    pub light_volume: UVec3,
+}
+
+impl TableSizes {
+    /// The sizes a scene asks for: its shadow map, and its light volume when its lighting model
+    /// reads one (else a single texel).
+    pub fn from_scene(scene: &crate::scene::Scene) -> TableSizes {
+        let light_volume = if scene.lighting.model == crate::scene::LightingModel::Volume {
+            let settings = LightVolumeSettings::from_scene(scene);
+            settings.cells() * UVec3::new(1, 1, settings.cascades)
+        } else {
+            UVec3::ONE
+        };
+        TableSizes {
+            shadow_texels: scene.shadow.resolution,
+            light_volume,
+        }
+    }
+
+    /// The smallest tables (tests of passes that read none of them).
+    pub const SMALLEST: TableSizes = TableSizes {
+        shadow_texels: 1,
+        light_volume: UVec3::ONE,
+    };
+}
+
+/// The shapes of bindings 1-7 for tables of `sizes`.
+fn shapes(sizes: TableSizes) -> [TableShape; 7] {
+    use wgpu::TextureViewDimension::{D2, D2Array, D3};
+    let volume = sizes.light_volume;
     // The aerial perspective's slices side by side (`atmosphere_aerial.wgsl`).
     let atlas = (AERIAL_SIZE.0 * AERIAL_SLICES, AERIAL_SIZE.1);
     let shape = |label, (w, h): (u32, u32), layers, dimension| TableShape {
@@ -188,22 +275,23 @@ fn shapes(shadow_texels: u32) -> [TableShape; 7] {
         shape("multiple scattering table", MULTIPLE_SCATTERING_SIZE, 1, D2),
         shape("sky irradiance table", IRRADIANCE_SIZE, 2, D2Array),
         shape("sky view table", SKY_VIEW_SIZE, 1, D2),
-        shape("aerial inscattering", atlas, 1, D2),
-        shape("aerial transmittance", atlas, 1, D2),
+        shape("aerial perspective", atlas, 2, D2Array),
         shape(
             "cloud shadow map",
-            (shadow_texels, shadow_texels),
+            (sizes.shadow_texels, sizes.shadow_texels),
             2,
             D2Array,
         ),
+        shape("light volume", (volume.x, volume.y), 2 * volume.z, D3),
     ]
 }
 
 fn make_texture(ctx: &GpuContext, shape: &TableShape, stand_in: bool) -> wgpu::Texture {
-    let (w, h, layers) = if stand_in {
-        (1, 1, shape.size.2)
-    } else {
-        shape.size
+    let three_d = shape.dimension == wgpu::TextureViewDimension::D3;
+    let (w, h, layers) = match (stand_in, three_d) {
+        (true, true) => (1, 1, 1),
+        (true, false) => (1, 1, shape.size.2),
+        (false, _) => shape.size,
     };
     ctx.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(shape.label),
@@ -214,7 +302,11 @@ fn make_texture(ctx: &GpuContext, shape: &TableShape, stand_in: bool) -> wgpu::T
         },
         mip_level_count: 1,
         sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
+        dimension: if three_d {
+            wgpu::TextureDimension::D3
+        } else {
+            wgpu::TextureDimension::D2
+        },
         format: TABLE_FORMAT,
         usage: wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::STORAGE_BINDING
@@ -243,17 +335,20 @@ pub struct EnvironmentGpu {
     bind_group: Option<wgpu::BindGroup>,
     writing: Vec<wgpu::BindGroup>,
     outputs: Vec<Vec<wgpu::TextureView>>,
-    shadow_texels: u32,
+    sizes: Option<TableSizes>,
     generation: u64,
 }
 
 impl EnvironmentGpu {
-    /// Makes the buffer (zeroed), the tables (a shadow map of `shadow_texels` per side) and the
-    /// bind groups.
-    pub fn new(ctx: &GpuContext, shadow_texels: u32) -> EnvironmentGpu {
+    /// Makes the buffer (zeroed), the tables (of `sizes`) and the bind groups.
+    pub fn new(ctx: &GpuContext, sizes: TableSizes) -> EnvironmentGpu {
         let buffer = uniform_buffer(ctx, "environment", size_of::<EnvironmentUniform>() as u64);
         let mut types = vec![UNIFORM];
-        types.extend(shapes(1).iter().map(|s| float_texture(s.dimension)));
+        types.extend(
+            shapes(TableSizes::SMALLEST)
+                .iter()
+                .map(|s| float_texture(s.dimension)),
+        );
         types.push(wgpu::BindingType::Sampler(
             wgpu::SamplerBindingType::Filtering,
         ));
@@ -264,7 +359,7 @@ impl EnvironmentGpu {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        let stand_ins = shapes(1)
+        let stand_ins = shapes(TableSizes::SMALLEST)
             .iter()
             .map(|s| whole_view(&make_texture(ctx, s, true), s.dimension))
             .collect();
@@ -278,20 +373,20 @@ impl EnvironmentGpu {
             bind_group: None,
             writing: Vec::new(),
             outputs: Vec::new(),
-            shadow_texels: 0,
+            sizes: None,
             generation: 0,
         };
-        gpu.resize_shadow_map(ctx, shadow_texels);
+        gpu.resize(ctx, sizes);
         gpu
     }
 
-    /// Remakes the tables and bind groups for a shadow map of `shadow_texels` per side (nothing
-    /// when it already has that size). The tables' contents are lost: fill them again.
-    pub fn resize_shadow_map(&mut self, ctx: &GpuContext, shadow_texels: u32) {
-        if shadow_texels == self.shadow_texels {
+    /// Remakes the tables and bind groups for tables of `sizes` (nothing when they already have
+    /// them). The tables' contents are lost: fill them again.
+    pub fn resize(&mut self, ctx: &GpuContext, sizes: TableSizes) {
+        if self.sizes == Some(sizes) {
             return;
         }
-        let shapes = shapes(shadow_texels);
+        let shapes = shapes(sizes);
         self.textures = shapes.iter().map(|s| make_texture(ctx, s, false)).collect();
         self.views = self
             .textures
@@ -308,17 +403,17 @@ impl EnvironmentGpu {
             .iter()
             .map(|t| self.storage_views(*t))
             .collect();
-        self.shadow_texels = shadow_texels;
+        self.sizes = Some(sizes);
         self.generation += 1;
     }
 
     /// The views a pass writes `table` through: the whole texture, or one view per layer of an
-    /// array (irradiance and mean radiance; the sun's and the sky's columns), or both volumes of
-    /// the aerial perspective.
+    /// array (irradiance and mean radiance; the aerial perspective's in-scattering and
+    /// transmittance; the sun's and the sky's columns).
     fn storage_views(&self, table: EnvironmentTable) -> Vec<wgpu::TextureView> {
         let texture = &self.textures[table.bindings()[0] - 1];
         match table {
-            EnvironmentTable::Irradiance | EnvironmentTable::CloudShadow => (0..2)
+            EnvironmentTable::Irradiance | EnvironmentTable::Aerial | EnvironmentTable::CloudShadow => (0..2)
                 .map(|layer| {
                     texture.create_view(&wgpu::TextureViewDescriptor {
                         dimension: Some(wgpu::TextureViewDimension::D2),
@@ -328,7 +423,6 @@ impl EnvironmentGpu {
                     })
                 })
                 .collect(),
-            EnvironmentTable::Aerial => vec![self.views[4].clone(), self.views[5].clone()],
             _ => vec![texture.create_view(&Default::default())],
         }
     }
@@ -390,7 +484,12 @@ impl EnvironmentGpu {
 
     /// Texels per side of the shadow map.
     pub fn shadow_texels(&self) -> u32 {
-        self.shadow_texels
+        self.sizes().shadow_texels
+    }
+
+    /// The tables' sizes.
+    pub fn sizes(&self) -> TableSizes {
+        self.sizes.expect("made by new")
     }
 }
 
@@ -407,10 +506,11 @@ pub static ENVIRONMENT_WGSL: crate::shader::WgslModule = crate::shader::wgsl_mod
 
 /// The environment's constants as WGSL.
 fn environment_constants() -> String {
-    crate::shader::wgsl_consts([(
-        "SUN_PIXEL_ROWS",
-        crate::shader::WgslConst::U32(super::SUN_PIXEL_ROWS),
-    )])
+    use crate::shader::WgslConst::U32;
+    crate::shader::wgsl_consts([
+        ("SUN_PIXEL_ROWS", U32(super::SUN_PIXEL_ROWS)),
+        ("LIGHT_VOLUME_MAX_CASCADES", U32(MAX_CASCADES)),
+    ])
 }
 
 impl crate::pass::SharedGroup for EnvironmentGpu {
@@ -446,6 +546,21 @@ mod tests {
                 sun_limb_darkening,
                 air,
                 shadow,
+                light_volume,
+            }
+        );
+        assert_wgsl_layout!(
+            &crate::probe::PROBE_WGSL,
+            "LightVolume",
+            LightVolumeUniform {
+                cascade_min_m,
+                cascade_cell_m,
+                cells,
+                cascades,
+                optics,
+                enabled,
+                beam_steps,
+                pad,
             }
         );
         assert_wgsl_layout!(

@@ -30,10 +30,10 @@ mod table_pass;
 
 pub use atmosphere_passes::{ATMOSPHERE_AERIAL_WGSL, ATMOSPHERE_LUTS_WGSL, ATMOSPHERE_MARCH_WGSL};
 pub use gpu::{
-    AirUniform, CloudShadowUniform, ENVIRONMENT_WGSL, EnvironmentGpu, EnvironmentTable,
+    AirUniform, CloudShadowUniform, ENVIRONMENT_WGSL, EnvironmentGpu, EnvironmentTable, LightVolumeUniform, TableSizes,
     EnvironmentUniform, TABLE_FORMAT,
 };
-pub use passes::EnvironmentPasses;
+pub use passes::{EnvironmentPasses, FrameLightVolume};
 pub use shadow_pass::CLOUD_SHADOW_WGSL;
 pub use table_pass::TablePass;
 

@@ -77,6 +77,9 @@ pub enum ProbeFunction {
     /// `environment_sun_disc_pixel_radiance(a.xyz, b.xyz, c.xyz)`:
     /// `ViewedEnvironment::sun_disc_pixel_radiance`.
     SunDiscPixelRadiance = 27,
+    /// `environment_light_volume_diffuse(a.xyz, toward the eye b.xyz)`:
+    /// `LightVolume::diffuse`.
+    LightVolumeDiffuse = 28,
 }
 
 /// The inputs of one evaluation.

@@ -52,6 +52,7 @@ fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>) ->
             return sprite_level(colors, array<f32, 5>(c.x, c.y, c.z, c.w, d.x), d.y);
         }
         case 27u: { return vec4<f32>(environment_sun_disc_pixel_radiance(a.xyz, b.xyz, c.xyz), 0.0); }
+        case 28u: { return vec4<f32>(environment_light_volume_diffuse(a.xyz, b.xyz), 0.0); }
         default: { return vec4<f32>(-1.0); }
     }
 }

@@ -95,6 +95,9 @@ impl MarchSettings {
     }
 }
 
+/// `March::lighting_model` of the light volume.
+const LIGHTING_MODEL_VOLUME: u32 = 2;
+
 /// The `March` uniform of `raymarch.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -136,7 +139,7 @@ impl MarchUniform {
             lighting_model: match settings.model {
                 LightingModel::Slab => 0,
                 LightingModel::Octaves => 1,
-                LightingModel::Volume => 2,
+                LightingModel::Volume => LIGHTING_MODEL_VOLUME,
             },
             back_steps: settings.back_steps(),
             slab_params: Vec4::from_array(settings.slab.params_to_gpu()),
@@ -218,6 +221,10 @@ impl Technique for RaymarchRenderer {
 
     fn pass_names(&self) -> &'static [&'static str] {
         &["raymarch"]
+    }
+
+    fn reads_light_volume(&self) -> bool {
+        self.settings.lighting_model == LIGHTING_MODEL_VOLUME
     }
 
     fn configure(&mut self, ctx: &GpuContext, scene: &Scene, _: &Path) -> Result<(), FieldError> {

@@ -15,7 +15,7 @@ struct March {
     ambient_scale: f32,         // scale of sky and ground light
     empty_space_skipping: u32,  // 1 to skip empty space with the hi-height pyramid
     tile_width: u32,            // width of the texel band this dispatch covers
-    lighting_model: u32,        // 0: slab (optics/slab.rs), 1: octaves
+    lighting_model: u32,        // 0: slab (optics/slab.rs), 1: octaves, 2: the light volume
     tile_origin: vec2<u32>,     // first texel of the band
     back_steps: u32,            // samples away from the sun from each view sample (slab)
     reserved: u32,
@@ -48,17 +48,24 @@ struct MarchSum {
 
 // Rays stop once this little light gets through (VolumeCloud's threshold, peers.md).
 const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
+// Whether the diffuse light comes from the environment's light volume.
+fn march_reads_volume() -> bool {
+    return march.lighting_model == 2u;
+}
+
 // The sun's light scattered at p toward the eye along d, per unit sigma_s and unit irradiance, by
-// the scene's model of multiple scattering, with tau_sun the optical depth toward the sun.
+// the scene's model of multiple scattering, with tau_sun the optical depth toward the sun. With the
+// light volume only single scattering and the forward peak's beam: the volume holds the rest.
 fn march_sun_scattering(p: vec3<f32>, d: vec3<f32>, tau_sun: f32, jitter: f32) -> f32 {
     let cos_theta = dot(d, environment_sun_direction());
-    // Both models, chosen by select: lavapipe recompiles (and leaks) a shader that branches on a
-    // uniform alone at every upload. The octave model marches no back samples (back_steps = 0).
+    // Every model, chosen by select: lavapipe recompiles (and leaks) a shader that branches on a
+    // uniform alone at every upload. Only the slab marches back samples (back_steps = 0 else).
     let slab = SlabModel(march.phase_lobes, march.slab_params);
     let by_slab = slab_scattering(slab, cos_theta, tau_sun, march_back_optical_depth(p, march.back_steps, jitter));
     let factors = vec3<f32>(march.octave_attenuation, march.octave_contribution, march.octave_eccentricity);
     let by_octaves = phase_octaves(march.phase_lobes, factors, march.octaves, cos_theta, tau_sun);
-    return select(by_octaves, by_slab, march.lighting_model == 0u);
+    let by_volume = phase_eval(march.phase_lobes, cos_theta) * exp(-tau_sun) + slab_peak_beam(slab, cos_theta, tau_sun);
+    return select(select(by_octaves, by_slab, march.lighting_model == 0u), by_volume, march_reads_volume());
 }
 
 // The coarse optical depths (up, down) from p at altitude h to the top and the bottom of the
@@ -91,6 +98,15 @@ struct MarchLight {
     sun: vec3<f32>,
     sky_above: vec3<f32>,
     from_below: vec3<f32>,
+}
+
+// The diffuse light scattered at p toward the eye along d, per unit sigma_s: the light volume's,
+// or the sky's and the ground's through the two-stream column (the slab's and the octaves'
+// multiple scattering is in march_sun_scattering).
+fn march_diffuse(p: vec3<f32>, d: vec3<f32>, light: MarchLight) -> vec3<f32> {
+    let from_volume = environment_light_volume_diffuse(p, -d);
+    let from_column = march_ambient(march_column(p, field_altitude_m(p)), light);
+    return select(from_column, from_volume, march_reads_volume());
 }
 
 // MarchLight at p. Looked up once per ray, where it enters the cloud shell (not where empty-space
@@ -167,10 +183,9 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
         if sigma_t <= 0.0 {
             continue;
         }
-        let column = march_column(p, field_altitude_m(p));
         let tau_sun = march_sun_optical_depth(p, march.light_steps, jitter);
         let sun = march_sun_scattering(p, d, tau_sun, jitter) * light.sun;
-        let source = albedo * (sun + march_ambient(column, light));
+        let source = albedo * (sun + march_diffuse(p, d, light));
         let step_transmittance = exp(-sigma_t * dt);
         radiance += transmittance * source * (1.0 - step_transmittance);
         distance_weighted += transmittance * (1.0 - step_transmittance) * distance(p, o);

@@ -10,7 +10,11 @@
 //! statistics come back a frame late ([`CloudRenderer::stats`]).
 
 use super::dispatch;
-use crate::environment::{Environment, EnvironmentGpu, EnvironmentPasses, EnvironmentUniform, Sky};
+use crate::environment::light_volume::{DiffuseOptics, LightVolumeGrid, LightVolumeSettings};
+use crate::environment::{
+    Environment, EnvironmentGpu, EnvironmentPasses, EnvironmentUniform, LightVolumeUniform, Sky,
+    TableSizes,
+};
 pub use crate::field::gpu::FieldUpdate;
 
 use crate::field::gpu::FieldGpu;
@@ -22,6 +26,7 @@ use crate::output::{CloudOutput, SampleGrid};
 use crate::pass::Shared;
 use crate::post::upsample::Upsampler;
 use crate::post::{Background, Compositor, DISPLAY_FORMAT, Display, HDR_FORMAT};
+use crate::optics::PhaseLobes;
 use crate::scene::Scene;
 use crate::shadow::{BuiltShadow, ShadowParams, ShadowReuse};
 use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
@@ -135,6 +140,8 @@ pub struct CloudRenderer {
     shadow_reuse: Option<ShadowReuse>,
     shadow_built: Option<BuiltShadow>,
     shadow_rebuild: bool,
+    /// The light volume of the frame begun, when the technique reads one.
+    light_volume: Option<(LightVolumeGrid, LightVolumeSettings)>,
 }
 
 impl CloudRenderer {
@@ -148,7 +155,7 @@ impl CloudRenderer {
         let field = CloudField::new(scene, base_dir)?;
         let field_gpu = FieldGpu::new(ctx, &field);
         let frame_gpu = FrameGpu::new(ctx, "frame");
-        let environment_gpu = EnvironmentGpu::new(ctx, scene.shadow.resolution);
+        let environment_gpu = EnvironmentGpu::new(ctx, TableSizes::from_scene(scene));
         let shared = Shared {
             field: &field_gpu,
             frame: &frame_gpu,
@@ -182,6 +189,7 @@ impl CloudRenderer {
             shadow_reuse: None,
             shadow_built: None,
             shadow_rebuild: true,
+            light_volume: None,
         })
     }
 
@@ -296,7 +304,7 @@ impl CloudRenderer {
             "compose",
             "display",
         ];
-        EnvironmentPasses::pass_names(&self.environment.0)
+        EnvironmentPasses::pass_names(&self.environment.0, self.technique.reads_light_volume())
             .into_iter()
             .chain(self.technique.pass_names().iter().copied())
             .chain(shared)
@@ -341,9 +349,15 @@ impl CloudRenderer {
             .write(ctx, &frame.uniform(&grid, &self.frame_settings));
         let env = Environment::new(&self.sky, &frame.sun);
         let shadow = self.frame_shadow(&env, frame);
-        let shadow_texels = self.settings.shadow.resolution;
-        self.environment_gpu.resize_shadow_map(ctx, shadow_texels);
-        let uniform = EnvironmentUniform::new(&env, frame.camera_position_m, &shadow);
+        self.environment_gpu
+            .resize(ctx, TableSizes::from_scene(&self.settings));
+        self.light_volume = self.technique.reads_light_volume().then(|| {
+            let settings = LightVolumeSettings::from_scene(&self.settings);
+            let grid = LightVolumeGrid::new(&settings, &self.field, frame.camera_position_m);
+            (grid, settings)
+        });
+        let uniform = EnvironmentUniform::new(&env, frame.camera_position_m, &shadow)
+            .with_light_volume(self.light_volume_uniform());
         self.environment_gpu.write(ctx, &uniform);
         self.environment = (env, true);
         let inputs = FrameInputs {
@@ -378,6 +392,14 @@ impl CloudRenderer {
         let used = kept.unwrap_or(fresh);
         self.shadow_built = Some(used);
         used.params
+    }
+
+    /// The frame's light volume as the environment's uniform holds it.
+    fn light_volume_uniform(&self) -> LightVolumeUniform {
+        let s = &self.settings;
+        let optics = DiffuseOptics::of(&s.lighting.sun_slab(PhaseLobes::from_scene(&s.phase)));
+        let volume = self.light_volume.as_ref();
+        LightVolumeUniform::new(volume.map(|(grid, settings)| (grid, optics, settings.beam_steps)))
     }
 
     /// The wind of the first layer, which carries the clouds (zero without layers).
@@ -448,8 +470,9 @@ impl CloudRenderer {
             environment: &self.environment_gpu,
         };
         let groups = (&shared, &self.environment_gpu);
+        let volume = self.light_volume.as_ref().map(|(g, s)| (g, s));
         self.environment_passes
-            .encode(ctx, encoder, groups, (env, self.shadow_rebuild), timer);
+            .encode(ctx, encoder, groups, (env, self.shadow_rebuild, volume), timer);
         *pending = false;
     }
 

@@ -23,10 +23,10 @@ use std::time::{Duration, Instant};
 /// Rows of output texels rendered per submission when reporting progress.
 const TILE_ROWS: u32 = 32;
 
-/// GPU passes of one frame at most: the environment's (the shadow map and up to five sky tables),
-/// the technique's (up to three), the temporal resolve or the upsampling, compose and display
+/// GPU passes of one frame at most: the environment's (the shadow map, up to five sky tables and
+/// the light volume's three), the technique's (up to three), the temporal resolve or the upsampling, compose and display
 /// ([`CloudRenderer::pass_names`]); a [`PassTimer`] of this capacity times them all.
-pub const PASS_COUNT: u32 = 12;
+pub const PASS_COUNT: u32 = 15;
 
 /// The images of one render.
 pub struct Rendered {

@@ -14,7 +14,7 @@ pub const BEAM_GROWTH: f32 = 1.1;
 /// Longest path of the beam toward the sun, metres (a low sun's path to the top of the layers).
 pub const BEAM_PATH_MAX_M: f32 = 16000.0;
 /// Lowest sun height the beam's path length follows (the path stays bounded).
-const BEAM_MIN_SUN_Y: f32 = 0.02;
+pub const BEAM_MIN_SUN_Y: f32 = 0.02;
 
 /// The offsets of a cell's eight extinction samples, in cells from its centre.
 pub const CELL_SAMPLE_OFFSET: f32 = 0.25;

@@ -24,12 +24,14 @@
 //! The GPU twin is `light_volume.wgsl` ([`LightVolumePass`]); the tests hold it to this module.
 
 pub mod inputs;
-// mod pass;
+mod pass;
+mod read;
 pub mod solve;
 #[cfg(test)]
 mod tests;
 
-// pub use pass::{LIGHT_VOLUME_PASS_NAMES, LIGHT_VOLUME_WGSL, LightVolumePass};
+pub use pass::{LIGHT_VOLUME_PASS_NAMES, LIGHT_VOLUME_WGSL, LightVolumePass};
+pub use read::LightVolume;
 pub use solve::{Boundaries, DiffuseField, Diffusion};
 
 use crate::field::CloudField;

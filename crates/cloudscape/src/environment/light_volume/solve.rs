@@ -129,21 +129,26 @@ impl Diffusion {
     }
 
     /// The flux-limited diffusion coefficient of cell `c` from the radiance's luminance gradient
-    /// (central differences, one-sided at the faces), at most the grid's height.
+    /// (central differences, one-sided at the faces) over the largest luminance of the cells the
+    /// gradient reads (the cell's own lags behind a sweep: a dark cell beside a lit one would
+    /// get no diffusion at all and gather the light it should pass on), at most the grid's
+    /// height.
     pub fn limited_diffusion(&self, field: &DiffuseField, c: UVec3) -> f32 {
         let lum = |c: UVec3| field.radiance[self.index(c)].dot(LUMINANCE);
         let h = self.cascade.cell_m;
         let mut gradient = Vec3::ZERO;
+        let mut brightest = lum(c);
         for axis in 0..3 {
             let (lo, hi) = (c[axis].saturating_sub(1), (c[axis] + 1).min(self.cells[axis] - 1));
             let (mut a, mut b) = (c, c);
             a[axis] = lo;
             b[axis] = hi;
+            brightest = brightest.max(lum(a)).max(lum(b));
             if hi > lo {
                 gradient[axis] = (lum(b) - lum(a)) / ((hi - lo) as f32 * h[axis]);
             }
         }
-        let relative = gradient.length() / lum(c).max(1e-12);
+        let relative = gradient.length() / brightest.max(1e-12);
         let height_m = h.y * self.cells.y as f32;
         flux_limited_diffusion(self.transport(self.index(c)), relative).min(height_m)
     }
@@ -235,6 +240,29 @@ impl Diffusion {
             conductance * (Vec3::ONE - alpha) * scale,
             (outward_beam - conductance * beta) * scale,
         )
+    }
+
+    /// The current `J = -D grad I0 + B` of cell `c` (luminance, central differences one-sided at
+    /// the faces) over its radiance's luminance: what the table stores beside `I0`
+    /// (`light_volume_export`).
+    pub fn relative_current(&self, field: &DiffuseField, c: UVec3) -> Vec3 {
+        let i = self.index(c);
+        let lum = |c: UVec3| field.radiance[self.index(c)].dot(LUMINANCE);
+        let mut current = Vec3::ZERO;
+        for axis in 0..3 {
+            let (lo, hi) = (c[axis].saturating_sub(1), (c[axis] + 1).min(self.cells[axis] - 1));
+            let (mut a, mut b) = (c, c);
+            a[axis] = lo;
+            b[axis] = hi;
+            let gradient = if hi > lo {
+                (lum(b) - lum(a)) / ((hi - lo) as f32 * self.cascade.cell_m[axis])
+            } else {
+                0.0
+            };
+            current[axis] = -field.diffusion_m[i] * gradient
+                + self.beam_current(field, i, axis).dot(LUMINANCE);
+        }
+        current / lum(c).max(1e-12)
     }
 
     /// Diffuse power leaving the grid through its top and its bottom, `4 pi J . n` summed over

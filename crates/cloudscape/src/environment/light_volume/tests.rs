@@ -162,3 +162,4 @@ fn light_diffuses_sideways_out_of_a_lit_column() {
     assert_eq!(glow(1), 0.0, "the first sweep of a cold start keeps columns apart");
     assert!(glow(20) > 0.0);
 }
+

@@ -1,0 +1,313 @@
+// The light volume's solve (environment/light_volume): per cell the scaled extinction and beam,
+// then sweeps of the flux limiter and the red-black line relaxation, then the table the
+// environment reads. solve.rs and inputs.rs are the CPU twins and derive every formula.
+//
+// Cells are numbered x fastest, then y (up), then z, then the cascade; dispatches over cells run
+// on a 2-D grid of (x, the rest) and over columns on (x, z + the cascade's z).
+
+// Per cell: the scaled sun beam's irradiance (rgb) and the scaled extinction (w), m^-1.
+@group(3) @binding(0) var<storage, read_write> volume_cells: array<vec4<f32>>;
+// Per cell: the mean diffuse radiance I0 (rgb).
+@group(3) @binding(1) var<storage, read_write> volume_radiance: array<vec4<f32>>;
+// Per cell: the flux-limited diffusion coefficient, metres.
+@group(3) @binding(2) var<storage, read_write> volume_diffusion: array<f32>;
+// The environment's table: I0 of each cascade side by side along z, then J / I0 the same way.
+@group(3) @binding(3) var volume_table_out: texture_storage_3d<rgba16float, write>;
+
+const LIGHT_VOLUME_LUMINANCE = vec3<f32>(0.2126, 0.7152, 0.0722);
+
+fn light_volume_cells_of() -> vec3<u32> {
+    return environment.light_volume.cells;
+}
+
+// Index of cell c of cascade k.
+fn light_volume_index(c: vec3<u32>, k: u32) -> u32 {
+    let n = light_volume_cells_of();
+    return c.x + n.x * (c.y + n.y * (c.z + n.z * k));
+}
+
+// The cell and cascade of a cell dispatch's invocation id (x, the rest); false past the end.
+fn light_volume_cell_of(id: vec2<u32>) -> vec4<u32> {
+    let n = light_volume_cells_of();
+    let rest = id.y;
+    return vec4<u32>(id.x, rest % n.y, (rest / n.y) % n.z, rest / (n.y * n.z));
+}
+
+fn light_volume_in_cells(id: vec2<u32>) -> bool {
+    let n = light_volume_cells_of();
+    return id.x < n.x && id.y < n.y * n.z * environment.light_volume.cascades;
+}
+
+// Centre of cell c of cascade k (LightVolumeCascade::centre).
+fn light_volume_centre(c: vec3<u32>, k: u32) -> vec3<f32> {
+    let v = environment.light_volume;
+    return v.cascade_min_m[k].xyz + (vec3<f32>(c) + 0.5) * v.cascade_cell_m[k].xyz;
+}
+
+// Cell inputs (inputs::cell_inputs): the mean coarse extinction at eight points, scaled, and the
+// sun's irradiance through the air times exp(-tau') of the coarse field toward the sun.
+@compute @workgroup_size(8, 8)
+fn light_volume_cells(@builtin(global_invocation_id) id: vec3<u32>) {
+    if !light_volume_in_cells(id.xy) {
+        return;
+    }
+    let v = environment.light_volume;
+    let ck = light_volume_cell_of(id.xy);
+    let c = ck.xyz;
+    let k = ck.w;
+    let p = light_volume_centre(c, k);
+    let cell_m = v.cascade_cell_m[k].xyz;
+    var sum = 0.0;
+    for (var s = 0u; s < 8u; s++) {
+        let corner = vec3<f32>(f32(s & 1u), f32((s >> 1u) & 1u), f32((s >> 2u) & 1u));
+        sum += field_extinction_coarse(p + (corner * 2.0 - 1.0) * LIGHT_VOLUME_CELL_SAMPLE_OFFSET * cell_m);
+    }
+    let thinning = v.optics.z;
+    let extinction = thinning * sum / 8.0;
+    let sun = environment.sun_direction;
+    let top_m = v.cascade_min_m[k].y + cell_m.y * f32(v.cells.y);
+    let length_m = clamp((top_m - p.y) / max(sun.y, LIGHT_VOLUME_BEAM_MIN_SUN_Y), 0.0, LIGHT_VOLUME_BEAM_PATH_MAX_M);
+    let tau = field_optical_depth_coarse(p, sun, vec3<f32>(0.0, length_m, LIGHT_VOLUME_BEAM_GROWTH), v.beam_steps, 0.5);
+    let beam = environment_sun_irradiance(p) * exp(-thinning * tau);
+    var cell = vec4<f32>(beam, extinction);
+    if v.enabled == 0u {
+        cell = vec4<f32>(0.0);
+    }
+    volume_cells[light_volume_index(c, k)] = cell;
+}
+
+fn light_volume_luminance(c: vec3<u32>, k: u32) -> f32 {
+    return dot(volume_radiance[light_volume_index(c, k)].rgb, LIGHT_VOLUME_LUMINANCE);
+}
+
+// Transport coefficient sigma_tr of a cell's scaled extinction (Diffusion::transport).
+fn light_volume_transport(extinction: f32) -> f32 {
+    let o = environment.light_volume.optics;
+    return extinction * (1.0 - o.x * o.y);
+}
+
+// solve::flux_limited_diffusion.
+fn light_volume_flux_limited(transport: f32, relative: f32) -> f32 {
+    return 1.0 / max(max(3.0 * transport, relative), 1e-30);
+}
+
+// The flux-limited diffusion coefficient of every cell from the radiance's luminance gradient over
+// the brightest cell it reads (Diffusion::limited_diffusion).
+@compute @workgroup_size(8, 8)
+fn light_volume_limit(@builtin(global_invocation_id) id: vec3<u32>) {
+    if !light_volume_in_cells(id.xy) {
+        return;
+    }
+    let v = environment.light_volume;
+    let ck = light_volume_cell_of(id.xy);
+    let c = ck.xyz;
+    let k = ck.w;
+    let h = v.cascade_cell_m[k].xyz;
+    var gradient = vec3<f32>(0.0);
+    var brightest = light_volume_luminance(c, k);
+    for (var axis = 0u; axis < 3u; axis++) {
+        let lo_i = max(c[axis], 1u) - 1u;
+        let hi_i = min(c[axis] + 1u, v.cells[axis] - 1u);
+        var a = c;
+        var b = c;
+        a[axis] = lo_i;
+        b[axis] = hi_i;
+        brightest = max(brightest, max(light_volume_luminance(a, k), light_volume_luminance(b, k)));
+        if hi_i > lo_i {
+            gradient[axis] = (light_volume_luminance(b, k) - light_volume_luminance(a, k)) / (f32(hi_i - lo_i) * h[axis]);
+        }
+    }
+    let relative = length(gradient) / max(brightest, 1e-12);
+    let height_m = h.y * f32(v.cells.y);
+    let extinction = volume_cells[light_volume_index(c, k)].w;
+    volume_diffusion[light_volume_index(c, k)] = min(light_volume_flux_limited(light_volume_transport(extinction), relative), height_m);
+}
+
+// The beam's current B along `axis` in cell i (Diffusion::beam_current).
+fn light_volume_beam_current(i: u32, axis: u32) -> vec3<f32> {
+    let o = environment.light_volume.optics;
+    let cell = volume_cells[i];
+    let beam_direction = -environment.sun_direction;
+    return 3.0 * volume_diffusion[i] * o.x * cell.w * o.y * beam_direction[axis] * cell.rgb / (4.0 * PI);
+}
+
+// The radiance entering the top (step 1) or bottom (-1) face of cell i as alpha I0 + beta
+// (Diffusion::entering); `top` the point the sky is looked up at.
+struct LightVolumeEntering {
+    alpha: vec3<f32>,
+    beta: vec3<f32>,
+}
+
+fn light_volume_entering(i: u32, step: i32, top: vec3<f32>) -> LightVolumeEntering {
+    if step > 0 {
+        return LightVolumeEntering(vec3<f32>(0.0), environment_sky_irradiance_up(top) / PI);
+    }
+    if frame.has_ground == 0u {
+        return LightVolumeEntering(vec3<f32>(0.0), environment_sky_radiance(vec3<f32>(0.0, -1.0, 0.0)));
+    }
+    let albedo = frame.ground_albedo;
+    let direct = volume_cells[i].rgb * max(environment.sun_direction.y, 0.0);
+    let denominator = 1.0 + albedo;
+    return LightVolumeEntering(2.0 * albedo / denominator, albedo * direct / (PI * denominator));
+}
+
+// Outward current through the top or bottom face of cell i as coefficient I0 + constant
+// (Diffusion::face_current).
+fn light_volume_face_current(i: u32, step: i32, h_y: f32, top: vec3<f32>) -> array<vec3<f32>, 2> {
+    let conductance = 2.0 * volume_diffusion[i] / h_y;
+    let entering = light_volume_entering(i, step, top);
+    let outward_beam = f32(step) * light_volume_beam_current(i, 1u);
+    let scale = 1.0 / (1.0 + 2.0 * conductance);
+    return array<vec3<f32>, 2>(conductance * (1.0 - entering.alpha) * scale, (outward_beam - conductance * entering.beta) * scale);
+}
+
+fn light_volume_harmonic(a: f32, b: f32) -> f32 {
+    return 2.0 * a * b / max(a + b, 1e-30);
+}
+
+// Solves column (x, z) of cascade k with its neighbours held (Diffusion::relax_column), by the
+// Thomas algorithm with a diagonal and right side per channel.
+fn light_volume_relax_column(x: u32, z: u32, k: u32, coupled: bool) {
+    let v = environment.light_volume;
+    let n = v.cells;
+    let h = v.cascade_cell_m[k].xyz;
+    let top = light_volume_centre(vec3<u32>(n.x / 2u, n.y - 1u, n.z / 2u), k);
+    var c_prime: array<vec3<f32>, LIGHT_VOLUME_MAX_COLUMN_CELLS>;
+    var d_prime: array<vec3<f32>, LIGHT_VOLUME_MAX_COLUMN_CELLS>;
+    var previous_c = vec3<f32>(0.0);
+    var previous_d = vec3<f32>(0.0);
+    for (var y = 0u; y < n.y; y++) {
+        let c = vec3<u32>(x, y, z);
+        let i = light_volume_index(c, k);
+        let d = volume_diffusion[i];
+        let cell = volume_cells[i];
+        var diag = vec3<f32>(cell.w * (1.0 - v.optics.x));
+        var rhs = v.optics.x * cell.w * cell.rgb / (4.0 * PI);
+        var lower = 0.0;
+        var upper = 0.0;
+        for (var a = 0u; a < 2u; a++) {
+            let axis = a * 2u;
+            for (var s = 0; s < 2; s++) {
+                let step = s * 2 - 1;
+                let neighbour = i32(c[axis]) + step;
+                if neighbour < 0 || neighbour >= i32(n[axis]) {
+                    continue;
+                }
+                var nc = c;
+                nc[axis] = u32(neighbour);
+                let j = light_volume_index(nc, k);
+                let face_b = 0.5 * (light_volume_beam_current(i, axis) + light_volume_beam_current(j, axis));
+                rhs -= f32(step) * face_b / h[axis];
+                if coupled {
+                    let conductance = light_volume_harmonic(d, volume_diffusion[j]) / (h[axis] * h[axis]);
+                    diag += vec3<f32>(conductance);
+                    rhs += conductance * volume_radiance[j].rgb;
+                }
+            }
+        }
+        for (var s = 0; s < 2; s++) {
+            let step = s * 2 - 1;
+            let neighbour = i32(y) + step;
+            let b_here = light_volume_beam_current(i, 1u);
+            if neighbour < 0 || neighbour >= i32(n.y) {
+                let face = light_volume_face_current(i, step, h.y, top);
+                diag += face[0] / h.y;
+                rhs -= face[1] / h.y;
+                continue;
+            }
+            let j = light_volume_index(vec3<u32>(x, u32(neighbour), z), k);
+            let face_b = 0.5 * (b_here + light_volume_beam_current(j, 1u));
+            rhs -= f32(step) * face_b / h.y;
+            let conductance = light_volume_harmonic(d, volume_diffusion[j]) / (h.y * h.y);
+            diag += vec3<f32>(conductance);
+            if step < 0 {
+                lower = -conductance;
+            } else {
+                upper = -conductance;
+            }
+        }
+        let m = diag - lower * previous_c;
+        previous_c = upper / m;
+        previous_d = (rhs - lower * previous_d) / m;
+        c_prime[y] = previous_c;
+        d_prime[y] = previous_d;
+    }
+    var next = vec3<f32>(0.0);
+    for (var r = 0u; r < n.y; r++) {
+        let y = n.y - 1u - r;
+        var value = d_prime[y];
+        if r > 0u {
+            value -= c_prime[y] * next;
+        }
+        next = value;
+        volume_radiance[light_volume_index(vec3<u32>(x, y, z), k)] = vec4<f32>(max(value, vec3<f32>(0.0)), 0.0);
+    }
+}
+
+// Relaxes the columns of one colour ((x + z) % 2 == colour) of every cascade.
+fn light_volume_relax(id: vec2<u32>, colour: u32, coupled: bool) {
+    let n = light_volume_cells_of();
+    if id.x >= n.x || id.y >= n.z * environment.light_volume.cascades {
+        return;
+    }
+    let z = id.y % n.z;
+    let k = id.y / n.z;
+    if (id.x + z) % 2u != colour {
+        return;
+    }
+    light_volume_relax_column(id.x, z, k, coupled);
+}
+
+@compute @workgroup_size(8, 8)
+fn light_volume_relax_red(@builtin(global_invocation_id) id: vec3<u32>) {
+    light_volume_relax(id.xy, 0u, true);
+}
+
+@compute @workgroup_size(8, 8)
+fn light_volume_relax_black(@builtin(global_invocation_id) id: vec3<u32>) {
+    light_volume_relax(id.xy, 1u, true);
+}
+
+@compute @workgroup_size(8, 8)
+fn light_volume_relax_red_uncoupled(@builtin(global_invocation_id) id: vec3<u32>) {
+    light_volume_relax(id.xy, 0u, false);
+}
+
+@compute @workgroup_size(8, 8)
+fn light_volume_relax_black_uncoupled(@builtin(global_invocation_id) id: vec3<u32>) {
+    light_volume_relax(id.xy, 1u, false);
+}
+
+// The table the environment reads (Diffusion::relative_current): I0 per cell, and the current
+// J = -D grad I0 + B of luminance over I0's luminance.
+@compute @workgroup_size(8, 8)
+fn light_volume_export(@builtin(global_invocation_id) id: vec3<u32>) {
+    if !light_volume_in_cells(id.xy) {
+        return;
+    }
+    let v = environment.light_volume;
+    let ck = light_volume_cell_of(id.xy);
+    let c = ck.xyz;
+    let k = ck.w;
+    let i = light_volume_index(c, k);
+    let h = v.cascade_cell_m[k].xyz;
+    var current = vec3<f32>(0.0);
+    for (var axis = 0u; axis < 3u; axis++) {
+        let lo_i = max(c[axis], 1u) - 1u;
+        let hi_i = min(c[axis] + 1u, v.cells[axis] - 1u);
+        var a = c;
+        var b = c;
+        a[axis] = lo_i;
+        b[axis] = hi_i;
+        var gradient = 0.0;
+        if hi_i > lo_i {
+            gradient = (light_volume_luminance(b, k) - light_volume_luminance(a, k)) / (f32(hi_i - lo_i) * h[axis]);
+        }
+        current[axis] = -volume_diffusion[i] * gradient + dot(light_volume_beam_current(i, axis), LIGHT_VOLUME_LUMINANCE);
+    }
+    let radiance = volume_radiance[i].rgb;
+    let relative = current / max(dot(radiance, LIGHT_VOLUME_LUMINANCE), 1e-12);
+    let texel = vec3<u32>(c.x, c.y, c.z + v.cells.z * k);
+    textureStore(volume_table_out, texel, vec4<f32>(radiance, 1.0));
+    textureStore(volume_table_out, texel + vec3<u32>(0u, 0u, v.cells.z * v.cascades), vec4<f32>(relative, 0.0));
+}

@@ -1,0 +1,169 @@
+//! The light volume's passes (`light_volume.wgsl`): the cells' inputs, the sweeps of the solve
+//! (warm-started while the grid stays put), and the table the environment reads.
+
+use super::inputs::{BEAM_GROWTH, BEAM_PATH_MAX_M, BEAM_MIN_SUN_Y, CELL_SAMPLE_OFFSET};
+use super::solve::MAX_COLUMN_CELLS;
+use super::{LightVolumeGrid, LightVolumeSettings};
+use crate::environment::{EnvironmentGpu, EnvironmentTable};
+use crate::gpu::pipeline::storage_buffer;
+use crate::gpu::{GpuContext, PassTimer};
+use crate::pass::{BindGroupCache, ComputePass, Shared};
+use glam::UVec2;
+
+/// Labels the passes are timed under: the cells' inputs, the solve's sweeps, the table.
+pub const LIGHT_VOLUME_PASS_NAMES: [&str; 3] =
+    ["light volume cells", "light volume solve", "light volume table"];
+
+const ENTRIES: [&str; 7] = [
+    "light_volume_cells",
+    "light_volume_limit",
+    "light_volume_relax_red",
+    "light_volume_relax_black",
+    "light_volume_relax_red_uncoupled",
+    "light_volume_relax_black_uncoupled",
+    "light_volume_export",
+];
+
+/// The solve's buffers (cells' inputs, radiance, diffusion coefficients) and pipelines, with the
+/// grid whose solution the radiance holds.
+pub struct LightVolumePass {
+    pass: ComputePass,
+    buffers: Option<[wgpu::Buffer; 3]>,
+    group: BindGroupCache,
+    solved: Option<LightVolumeGrid>,
+}
+
+impl LightVolumePass {
+    /// Builds the pipelines against the shared groups.
+    pub fn new(ctx: &GpuContext, shared: &Shared) -> LightVolumePass {
+        LightVolumePass {
+            pass: ComputePass::new(ctx, shared, "light volume", &LIGHT_VOLUME_WGSL, &ENTRIES),
+            buffers: None,
+            group: BindGroupCache::default(),
+            solved: None,
+        }
+    }
+
+    /// The buffer of per-cell radiance (`vec4<f32>`, I0 in rgb), for tests.
+    pub fn radiance_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.buffers.as_ref().map(|b| &b[1])
+    }
+
+    /// Makes the buffers hold `cells` cells; true when they were remade (and hold nothing).
+    fn ensure_buffers(&mut self, ctx: &GpuContext, cells: u64) -> bool {
+        let bytes = [16 * cells, 16 * cells, 4 * cells];
+        if self
+            .buffers
+            .as_ref()
+            .is_some_and(|b| b.iter().zip(bytes).all(|(b, n)| b.size() == n))
+        {
+            return false;
+        }
+        let labels = ["light volume cells", "light volume radiance", "light volume diffusion"];
+        self.buffers = Some([0, 1, 2].map(|i| storage_buffer(ctx, labels[i], bytes[i])));
+        self.group.clear();
+        true
+    }
+
+    /// Records the frame's volume for `grid` (the environment's uniform already holds it): a cold
+    /// solve of `settings.sweeps` sweeps when the grid is new or moved, else `warm_sweeps` from
+    /// the last solution.
+    pub fn encode(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        (shared, environment): (&Shared, &EnvironmentGpu),
+        (grid, settings): (&LightVolumeGrid, &LightVolumeSettings),
+        mut timer: Option<&mut PassTimer>,
+    ) {
+        assert!(
+            grid.cells.y <= MAX_COLUMN_CELLS,
+            "the light volume's columns hold at most {MAX_COLUMN_CELLS} cells"
+        );
+        let cascades = grid.cascades.len() as u32;
+        let cells = u64::from(grid.cells.element_product() * cascades);
+        let remade = self.ensure_buffers(ctx, cells);
+        let cold = remade || self.solved.as_ref() != Some(grid);
+        let buffers = self.buffers.as_ref().expect("made above");
+        if cold {
+            encoder.clear_buffer(&buffers[1], 0, None);
+        }
+        let views = environment.output_views(EnvironmentTable::LightVolume);
+        let pass = &self.pass;
+        let group = self.group.get(&views.iter().collect::<Vec<_>>(), || {
+            pass.group.bind(
+                ctx,
+                &[
+                    ("volume_cells", buffers[0].as_entire_binding()),
+                    ("volume_radiance", buffers[1].as_entire_binding()),
+                    ("volume_diffusion", buffers[2].as_entire_binding()),
+                    ("volume_table_out", wgpu::BindingResource::TextureView(&views[0])),
+                ],
+            )
+        });
+        let writing = environment.bind_group_writing(EnvironmentTable::LightVolume);
+        let groups = shared.bind_groups_with(pass.slots, writing, group);
+        let n = grid.cells;
+        let over_cells = UVec2::new(n.x, n.y * n.z * cascades);
+        let over_columns = UVec2::new(n.x, n.z * cascades);
+        let sweeps = if cold {
+            settings.sweeps.max(1)
+        } else {
+            settings.warm_sweeps
+        };
+        let mut steps = Vec::new();
+        for s in 0..sweeps {
+            let coupled = !(cold && s == 0);
+            steps.push((ENTRIES[1], over_cells));
+            let (red, black) = if coupled { (2, 3) } else { (4, 5) };
+            steps.push((ENTRIES[red], over_columns));
+            steps.push((ENTRIES[black], over_columns));
+        }
+        let [cells_name, solve_name, table_name] = LIGHT_VOLUME_PASS_NAMES;
+        let mut record = |label, steps: &[(&str, UVec2)]| {
+            let writes = timer.as_deref_mut().and_then(|t| t.compute_pass_writes(label));
+            let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(label),
+                timestamp_writes: writes,
+            });
+            for (i, g) in groups.iter().enumerate() {
+                if let Some(g) = g {
+                    compute.set_bind_group(i as u32, *g, &[]);
+                }
+            }
+            for (entry, size) in steps {
+                compute.set_pipeline(pass.pipeline(entry));
+                compute.dispatch_workgroups(size.x.div_ceil(8), size.y.div_ceil(8), 1);
+            }
+        };
+        record(cells_name, &[(ENTRIES[0], over_cells)]);
+        record(solve_name, &steps);
+        record(table_name, &[(ENTRIES[6], over_cells)]);
+        self.solved = Some(grid.clone());
+    }
+}
+
+/// The light volume's solve on the GPU (`light_volume.wgsl`).
+pub static LIGHT_VOLUME_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
+    "light_volume",
+    "light_volume.wgsl",
+    [
+        &crate::shader::MATH_WGSL,
+        &crate::field::gpu::FIELD_WGSL,
+        &crate::frame::FRAME_WGSL,
+        &crate::environment::ENVIRONMENT_WGSL
+    ],
+    light_volume_constants
+);
+
+/// The solve's constants as WGSL (inputs.rs and solve.rs).
+fn light_volume_constants() -> String {
+    use crate::shader::WgslConst::{F32, U32};
+    crate::shader::wgsl_consts([
+        ("LIGHT_VOLUME_CELL_SAMPLE_OFFSET", F32(CELL_SAMPLE_OFFSET)),
+        ("LIGHT_VOLUME_BEAM_GROWTH", F32(BEAM_GROWTH)),
+        ("LIGHT_VOLUME_BEAM_PATH_MAX_M", F32(BEAM_PATH_MAX_M)),
+        ("LIGHT_VOLUME_BEAM_MIN_SUN_Y", F32(BEAM_MIN_SUN_Y)),
+        ("LIGHT_VOLUME_MAX_COLUMN_CELLS", U32(MAX_COLUMN_CELLS)),
+    ])
+}

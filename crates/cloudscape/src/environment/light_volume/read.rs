@@ -1,0 +1,78 @@
+//! A frame's light volume solved on the CPU and read as the march reads it: the specification of
+//! the GPU passes and of `environment_light_volume_diffuse`.
+
+use super::inputs::{VolumeLight, diffusion};
+use super::solve::{DiffuseField, Diffusion};
+use super::{DiffuseOptics, LightVolumeGrid, LightVolumeSettings};
+use crate::field::CloudField;
+use glam::{UVec3, Vec3};
+
+/// Every cascade's problem and its solution.
+pub struct LightVolume {
+    /// The cascades' problems, finest first.
+    pub cascades: Vec<(Diffusion, DiffuseField)>,
+    /// Whether there are clouds (the volume reads zero when not).
+    pub enabled: bool,
+}
+
+impl LightVolume {
+    /// Solves every cascade of `grid` from a cold start with `settings.sweeps` sweeps, as a
+    /// frame's first solve does on the GPU.
+    pub fn solve(
+        grid: &LightVolumeGrid,
+        settings: &LightVolumeSettings,
+        (field, optics): (&CloudField, DiffuseOptics),
+        light: &VolumeLight,
+    ) -> LightVolume {
+        let cascades = (0..grid.cascades.len())
+            .map(|k| {
+                let problem = diffusion((grid, k), settings, (field, optics), light);
+                let mut solution = problem.cold_field();
+                problem.solve(&mut solution, settings.sweeps.max(1), true);
+                (problem, solution)
+            })
+            .collect();
+        LightVolume {
+            cascades,
+            enabled: grid.enabled,
+        }
+    }
+
+    /// The diffuse light at `p` scattered toward the eye along `toward_eye` (unit), per unit
+    /// scattering coefficient: `I0 (1 + 3 g J / I0 . w)` interpolated trilinearly in the finest
+    /// cascade holding `p` (`environment_light_volume_diffuse`).
+    pub fn diffuse(&self, p: Vec3, toward_eye: Vec3) -> Vec3 {
+        if !self.enabled {
+            return Vec3::ZERO;
+        }
+        let (problem, solution) = self.cascade_at(p);
+        let n = problem.cells.as_vec3();
+        let local = ((p - problem.cascade.min_m) / problem.cascade.cell_m)
+            .clamp(Vec3::splat(0.5), n - 0.5)
+            - 0.5;
+        let base = local.floor().as_uvec3().min(problem.cells - 1);
+        let f = local - base.as_vec3();
+        let (mut radiance, mut current) = (Vec3::ZERO, Vec3::ZERO);
+        for corner in 0..8u32 {
+            let step = UVec3::new(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+            let c = (base + step).min(problem.cells - 1);
+            let w = Vec3::select(step.cmpeq(UVec3::ONE).into(), f, Vec3::ONE - f).element_product();
+            radiance += w * solution.radiance[problem.index(c)];
+            current += w * problem.relative_current(solution, c);
+        }
+        let g = problem.optics.mean_cosine;
+        radiance * (1.0 + 3.0 * g * current.dot(toward_eye)).max(0.0)
+    }
+
+    /// The finest cascade holding `p` within half a cell of its sides, else the coarsest.
+    fn cascade_at(&self, p: Vec3) -> &(Diffusion, DiffuseField) {
+        self.cascades
+            .iter()
+            .find(|(problem, _)| {
+                let n = problem.cells.as_vec3();
+                let local = (p - problem.cascade.min_m) / problem.cascade.cell_m;
+                local.x >= 0.5 && local.z >= 0.5 && local.x <= n.x - 0.5 && local.z <= n.z - 0.5
+            })
+            .unwrap_or_else(|| self.cascades.last().expect("at least one cascade"))
+    }
+}
