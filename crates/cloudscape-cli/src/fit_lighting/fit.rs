@@ -17,6 +17,8 @@ pub enum Model {
     Octaves(Octaves, PhaseLobes),
     /// The δ-Eddington slab along the sun.
     Slab(SunSlab),
+    /// The light volume for the diffuse light, the slab's beam part per sample.
+    Volume(SunSlab),
 }
 
 impl Model {
@@ -25,6 +27,7 @@ impl Model {
         f64::from(match self {
             Model::Octaves(octaves, lobes) => octaves.scattering(lobes, s.cos_theta, s.tau_sun),
             Model::Slab(slab) => slab.scattering(s.cos_theta, s.tau_sun, s.tau_back),
+            Model::Volume(slab) => slab.beam_scattering(s.cos_theta, s.tau_sun) + s.volume_diffuse,
         })
     }
 
@@ -35,6 +38,66 @@ impl Model {
             .map(|s| (self.predict(s) - f64::from(s.source)).powi(2))
             .sum()
     }
+}
+
+/// Where in the clouds a sample lies, for the per-class figures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Class {
+    /// Inside a deck (stratus, stratocumulus), an optical depth of at least 3 below its sunlit
+    /// side.
+    DeckInterior,
+    /// The side of a tower (cumulus, cumulonimbus) seen level (the view within 20 degrees of the
+    /// horizon), not against the sun.
+    TowerSide,
+    /// A body seen against the sun (within 60 degrees of it), at least an optical depth of 3
+    /// from its sunlit side.
+    BacklitBody,
+    /// Anywhere else.
+    Other,
+}
+
+impl Class {
+    /// The classes in the order the tables print them.
+    pub const ALL: [Class; 4] = [
+        Class::DeckInterior,
+        Class::TowerSide,
+        Class::BacklitBody,
+        Class::Other,
+    ];
+
+    /// The class of sample `s`.
+    pub fn of(s: &Sample) -> Class {
+        if s.cos_theta > 0.5 && s.tau_sun >= 3.0 {
+            Class::BacklitBody
+        } else if s.family.is_deck() && s.tau_sun >= 3.0 {
+            Class::DeckInterior
+        } else if !s.family.is_deck() && s.direction.y.abs() < 0.34 && s.cos_theta < 0.5 {
+            Class::TowerSide
+        } else {
+            Class::Other
+        }
+    }
+
+    /// "deck interior".
+    pub fn name(self) -> &'static str {
+        match self {
+            Class::DeckInterior => "deck interior",
+            Class::TowerSide => "tower side",
+            Class::BacklitBody => "backlit body",
+            Class::Other => "other",
+        }
+    }
+}
+
+/// Mean prediction over mean source of `model` on the samples of `class`, and their count.
+pub fn class_ratio(model: &Model, samples: &[Sample], class: Class) -> (f64, usize) {
+    let (mut p, mut t, mut n) = (0.0, 0.0, 0);
+    for s in samples.iter().filter(|s| Class::of(s) == class) {
+        p += model.predict(s);
+        t += f64::from(s.source);
+        n += 1;
+    }
+    (p / t.max(1e-12), n)
 }
 
 /// How well a model predicts a set of samples.
@@ -151,6 +214,10 @@ mod tests {
                     sun_y: 0.5,
                     source: 0.0,
                     source_error: 0.0,
+                    point_m: glam::Vec3::ZERO,
+                    direction: glam::Vec3::X,
+                    family: super::super::samples::Family::Cumulus,
+                    volume_diffuse: f32::NAN,
                 };
                 sample.source = truth(&sample);
                 sample

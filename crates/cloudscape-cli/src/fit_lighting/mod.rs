@@ -13,8 +13,9 @@ use anyhow::{Context, Result};
 use clap::Args;
 use cloudscape::optics::PhaseLobes;
 use cloudscape::scene::Scene;
-use fit::{Model, Score, fit_octaves, fit_slab, score};
-use samples::{Sample, scene_samples};
+use fit::{Class, Model, Score, class_ratio, fit_octaves, fit_slab, score};
+use glam::Vec3;
+use samples::{Sample, fill_volume, scene_samples};
 use std::path::{Path, PathBuf};
 
 /// Index of the first held-out scene: far from the training scenes' indices.
@@ -77,6 +78,7 @@ pub fn run(args: FitLightingArgs) -> Result<()> {
             score(&model, &validation),
         );
     }
+    print_classes(lighting.sun_slab(lobes), fitted_slab, &training, &validation);
     println!(
         "\n[lighting]\nslab_diffuse_scale = {:.3}\nslab_back_scale = {:.3}\noctave_attenuation = {:.3}\noctave_contribution = {:.3}\noctave_eccentricity = {:.3}",
         fitted_slab.diffuse_scale,
@@ -88,9 +90,51 @@ pub fn run(args: FitLightingArgs) -> Result<()> {
     Ok(())
 }
 
+/// Per class of point, over every scene's points in the light volume's finest cascade: each
+/// model's mean prediction over the path tracer's mean source.
+fn print_classes(slab: cloudscape::optics::SunSlab, fitted: cloudscape::optics::SunSlab, training: &[Sample], validation: &[Sample]) {
+    let inside: Vec<Sample> = training
+        .iter()
+        .chain(validation)
+        .filter(|s| s.volume_diffuse.is_finite())
+        .copied()
+        .collect();
+    println!(
+        "\nBy class, the {} points of all scenes inside the light volume's finest cascade: mean \
+         prediction / mean path-traced source\n",
+        inside.len()
+    );
+    println!("| class | points | light volume | slab, default | slab, fitted |");
+    println!("|---|---|---|---|---|");
+    let models = [Model::Volume(slab), Model::Slab(slab), Model::Slab(fitted)];
+    for class in Class::ALL {
+        let ratios = models.map(|m| class_ratio(&m, &inside, class));
+        println!(
+            "| {} | {} | {:.3} | {:.3} | {:.3} |",
+            class.name(),
+            ratios[0].1,
+            ratios[0].0,
+            ratios[1].0,
+            ratios[2].0
+        );
+    }
+    let all = models.map(|m| score(&m, &inside));
+    println!(
+        "| all (rel. RMS) | {} | {:.3} ({:.3}) | {:.3} ({:.3}) | {:.3} ({:.3}) |",
+        inside.len(),
+        all[0].mean_ratio,
+        all[0].relative_rms,
+        all[1].mean_ratio,
+        all[1].relative_rms,
+        all[2].mean_ratio,
+        all[2].relative_rms
+    );
+}
+
 fn print_row(name: &str, model: &Model, training: Score, held_out: Score) {
     let factors = match model {
         Model::Slab(s) => format!("k {:.3}, back {:.3}", s.diffuse_scale, s.back_scale),
+        Model::Volume(_) => "none".to_string(),
         Model::Octaves(o, _) => format!(
             "a {:.3}, b {:.3}, c {:.3}",
             o.attenuation, o.contribution, o.eccentricity
@@ -118,7 +162,7 @@ fn gather(scenes: std::ops::Range<u32>, args: &FitLightingArgs) -> Result<Vec<Sa
             args.paths,
             cloudscape_reference::TRACER_REVISION
         ));
-        let samples = match read(&path) {
+        let mut samples = match read(&path, index)? {
             Some(samples) => samples,
             None => {
                 let samples = scene_samples(index, args.points, args.paths)?;
@@ -126,6 +170,7 @@ fn gather(scenes: std::ops::Range<u32>, args: &FitLightingArgs) -> Result<Vec<Sa
                 samples
             }
         };
+        fill_volume(index, &mut samples)?;
         all.extend(samples);
         bar.inc(1);
     }
@@ -134,31 +179,50 @@ fn gather(scenes: std::ops::Range<u32>, args: &FitLightingArgs) -> Result<Vec<Sa
 }
 
 /// Columns of a samples file.
-const HEADER: &str = "scene,tau_sun,tau_back,cos_theta,sun_y,source,source_error";
+const HEADER: &str =
+    "scene,tau_sun,tau_back,cos_theta,sun_y,source,source_error,x_m,y_m,z_m,dir_x,dir_y,dir_z";
 
 fn write(path: &Path, samples: &[Sample]) -> Result<()> {
     let mut text = format!("{HEADER}\n");
     for s in samples {
+        let (p, d) = (s.point_m, s.direction);
         text += &format!(
-            "{},{},{},{},{},{},{}\n",
-            s.scene, s.tau_sun, s.tau_back, s.cos_theta, s.sun_y, s.source, s.source_error
+            "{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            s.scene,
+            s.tau_sun,
+            s.tau_back,
+            s.cos_theta,
+            s.sun_y,
+            s.source,
+            s.source_error,
+            p.x,
+            p.y,
+            p.z,
+            d.x,
+            d.y,
+            d.z
         );
     }
     std::fs::write(path, text).with_context(|| path.display().to_string())
 }
 
-/// The samples in `path`; None when it is missing or not a samples file.
-fn read(path: &Path) -> Option<Vec<Sample>> {
-    let text = std::fs::read_to_string(path).ok()?;
+/// The samples of scene `index` in `path`; None when it is missing or not a samples file.
+fn read(path: &Path, index: u32) -> Result<Option<Vec<Sample>>> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Ok(None);
+    };
     let mut lines = text.lines();
-    (lines.next()? == HEADER).then_some(())?;
-    lines
+    if lines.next() != Some(HEADER) {
+        return Ok(None);
+    }
+    let (_, family) = samples::training_scene(index)?;
+    Ok(lines
         .map(|line| {
             let v: Vec<f32> = line
                 .split(',')
                 .map(|x| x.parse().ok())
                 .collect::<Option<_>>()?;
-            (v.len() == 7).then(|| Sample {
+            (v.len() == 13).then(|| Sample {
                 scene: v[0] as u32,
                 tau_sun: v[1],
                 tau_back: v[2],
@@ -166,7 +230,11 @@ fn read(path: &Path) -> Option<Vec<Sample>> {
                 sun_y: v[4],
                 source: v[5],
                 source_error: v[6],
+                point_m: Vec3::new(v[7], v[8], v[9]),
+                direction: Vec3::new(v[10], v[11], v[12]),
+                family,
+                volume_diffuse: f32::NAN,
             })
         })
-        .collect()
+        .collect())
 }

@@ -39,11 +39,49 @@ pub struct Sample {
     pub source: f32,
     /// Standard error of that estimate.
     pub source_error: f32,
+    /// The point, world metres.
+    pub point_m: Vec3,
+    /// The view ray's direction (from the eye).
+    pub direction: Vec3,
+    /// The scene's cloud family ([`Family`]).
+    pub family: Family,
+    /// The light volume's diffuse light there toward the eye, per unit sun irradiance (NaN
+    /// outside its finest cascade): filled by [`fill_volume`], not stored.
+    pub volume_diffuse: f32,
 }
 
-/// The generated training scene `index`: a cloud layer and a sun drawn from `index`, lit by the sun
-/// alone (no sky, no ground, no haze), so the light found at a point is the sun's.
-pub fn training_scene(index: u32) -> Result<SceneDocument> {
+/// The cloud family of a generated scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Family {
+    /// A stratus deck.
+    Stratus,
+    /// A stratocumulus deck.
+    Stratocumulus,
+    /// Cumulus.
+    Cumulus,
+    /// Cumulonimbus towers among cumulus.
+    Cumulonimbus,
+}
+
+impl Family {
+    /// Every family, in the order the scenes draw them.
+    pub const ALL: [Family; 4] = [
+        Family::Stratus,
+        Family::Stratocumulus,
+        Family::Cumulus,
+        Family::Cumulonimbus,
+    ];
+
+    /// Whether the family forms decks (else towers).
+    pub fn is_deck(self) -> bool {
+        matches!(self, Family::Stratus | Family::Stratocumulus)
+    }
+}
+
+/// The generated training scene `index` and its cloud family: a cloud layer and a sun drawn from
+/// `index`, lit by the sun alone (no sky, no ground, no haze), so the light found at a point is
+/// the sun's.
+pub fn training_scene(index: u32) -> Result<(SceneDocument, Family)> {
     let mut rng = Rng::for_sample(0x5eed, u64::from(index), 0);
     let mut draw = |lo: f32, hi: f32| lo + (hi - lo) * rng.next_f32();
     let elevation = draw(3.0, 87.0);
@@ -51,11 +89,12 @@ pub fn training_scene(index: u32) -> Result<SceneDocument> {
     let coverage = draw(0.15, 0.95);
     let extinction = draw(0.02, 0.09);
     let bottom = draw(800.0, 2300.0);
-    let (types, thickness) = match (draw(0.0, 4.0)) as u32 {
-        0 => ("{ stratus = 1.0 }", draw(200.0, 800.0)),
-        1 => ("{ stratocumulus = 1.0 }", draw(500.0, 1500.0)),
-        2 => ("{ cumulus = 1.0 }", draw(1000.0, 3500.0)),
-        _ => (
+    let family = Family::ALL[(draw(0.0, 4.0) as usize).min(3)];
+    let (types, thickness) = match family {
+        Family::Stratus => ("{ stratus = 1.0 }", draw(200.0, 800.0)),
+        Family::Stratocumulus => ("{ stratocumulus = 1.0 }", draw(500.0, 1500.0)),
+        Family::Cumulus => ("{ cumulus = 1.0 }", draw(1000.0, 3500.0)),
+        Family::Cumulonimbus => (
             "{ cumulonimbus = 0.6, cumulus = 0.4 }",
             draw(5000.0, 10000.0),
         ),
@@ -76,12 +115,12 @@ pub fn training_scene(index: u32) -> Result<SceneDocument> {
         format!("layers.0.noise_seed={}", 100 + index),
         format!("weather.seed={}", 200 + index),
     ];
-    Ok(SceneDocument::load(None, &overrides)?)
+    Ok((SceneDocument::load(None, &overrides)?, family))
 }
 
 /// `points` camera rays into training scene `index`, each collision estimated with `paths` paths.
 pub fn scene_samples(index: u32, points: u32, paths: u32) -> Result<Vec<Sample>> {
-    let doc = training_scene(index)?;
+    let (doc, family) = training_scene(index)?;
     let tracer = PathTracer::for_scene(
         &doc.scene,
         &doc.resolve_path(""),
@@ -94,7 +133,7 @@ pub fn scene_samples(index: u32, points: u32, paths: u32) -> Result<Vec<Sample>>
         .into_par_iter()
         .filter_map(|i| {
             let mut rng = Rng::for_sample(0xf17, u64::from(index) << 32 | u64::from(i), 0);
-            sample(&tracer, (index, light_steps, paths), &mut rng)
+            sample(&tracer, (index, family, light_steps, paths), &mut rng)
         })
         .collect();
     Ok(samples)
@@ -103,7 +142,7 @@ pub fn scene_samples(index: u32, points: u32, paths: u32) -> Result<Vec<Sample>>
 /// One camera ray's collision and its estimate; None when the ray meets no cloud.
 fn sample(
     tracer: &PathTracer<cloudscape_reference::CloudMedium>,
-    (index, light_steps, paths): (u32, u32, u32),
+    (index, family, light_steps, paths): (u32, Family, u32, u32),
     rng: &mut Rng,
 ) -> Option<Sample> {
     let field = tracer.volume.medium.field();
@@ -131,7 +170,47 @@ fn sample(
         sun_y: sun.y,
         source: mean as f32,
         source_error: ((sum_sq / n - mean * mean).max(0.0) / n).sqrt() as f32,
+        point_m: p,
+        direction: dir,
+        family,
+        volume_diffuse: f32::NAN,
     })
+}
+
+/// Solves the light volume of training scene `index` (the scene's own settings, centred over the
+/// middle of the cameras' square) and reads it at each of `samples` inside its finest cascade.
+pub fn fill_volume(index: u32, samples: &mut [Sample]) -> Result<()> {
+    use cloudscape::environment::light_volume::inputs::VolumeLight;
+    use cloudscape::environment::light_volume::{
+        DiffuseOptics, LightVolume, LightVolumeGrid, LightVolumeSettings,
+    };
+    use cloudscape::environment::{Environment, ViewedEnvironment};
+    let (doc, _) = training_scene(index)?;
+    let scene = &doc.scene;
+    let field = cloudscape::field::CloudField::new(scene, &doc.resolve_path(""))
+        .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
+    let settings = LightVolumeSettings::from_scene(scene);
+    let grid = LightVolumeGrid::new(&settings, &field, Vec3::ZERO);
+    let env = Environment::from_scene(scene);
+    let viewed = ViewedEnvironment::new(&env, Vec3::ZERO);
+    let light = VolumeLight {
+        environment: &viewed,
+        ground_albedo: None,
+        time_s: 0.0,
+    };
+    let lobes = cloudscape::optics::PhaseLobes::from_scene(&scene.phase);
+    let optics = DiffuseOptics::of(&scene.lighting.sun_slab(lobes));
+    let volume = LightVolume::solve(&grid, &settings, (&field, optics), &light);
+    let reach = settings.extent_m;
+    for s in samples {
+        let inside = s.point_m.x.abs() < reach && s.point_m.z.abs() < reach;
+        s.volume_diffuse = if inside {
+            volume.diffuse(s.point_m, -s.direction).y
+        } else {
+            f32::NAN
+        };
+    }
+    Ok(())
 }
 
 /// A camera ray: from the ground looking up, from inside the layers, or from above looking down.

@@ -54,7 +54,7 @@ fn register_font() -> Result<()> {
 }
 
 /// The colour of a family at a shade: the ray marcher's presets from light to deep blue, the
-/// particles orange, the sprites green, the ray marcher with the octave model purple.
+/// particles orange, the sprites green, the ray marcher with the slab model purple.
 fn colour(family: usize, shade: f64) -> RGBColor {
     let mix = |a: (f64, f64, f64), b: (f64, f64, f64)| {
         let t = shade.clamp(0.0, 1.0);

@@ -1,10 +1,10 @@
 //! The text of `docs/realism.md` and the series of its chart.
 
 use super::chart::ChartSeries;
-use super::measure::Variant;
+use super::measure::{COMPARED_MODEL, Variant};
 use super::regions::RegionErrors;
 use super::{ReportArgs, Row, particles, sprites};
-use cloudscape::scene::{LightingModel, Technique};
+use cloudscape::scene::Technique;
 use cloudscape_reference::regions::Region;
 use std::fmt::Write as _;
 
@@ -67,24 +67,24 @@ fn raymarch_section(s: &mut String, rows: &[Row]) {
         s,
         "## The ray marcher\n\n\
          At each scene's own quality preset, with the scene's model of multiple scattering (the \
-         δ-Eddington slab, `docs/lighting.md`); *octaves* is the same march with the octave model \
-         it replaced (`lighting.model = \"octaves\"`).\n\n\
-         | scene | HDR-FLIP mean | p95 | relMSE | luminance ratio | octaves: HDR-FLIP / luminance ratio | reference noise (HDR-FLIP / relMSE) | halves (HDR-FLIP) | reference spp | paths/s |\n\
+         light volume, `docs/lighting.md`); *slab* is the same march with the δ-Eddington slab \
+         along the sun it replaced (`lighting.model = \"slab\"`).\n\n\
+         | scene | HDR-FLIP mean | p95 | relMSE | luminance ratio | slab: HDR-FLIP / luminance ratio | reference noise (HDR-FLIP / relMSE) | halves (HDR-FLIP) | reference spp | paths/s |\n\
          |---|---|---|---|---|---|---|---|---|---|"
     );
     for r in rows {
         let c = &r.raymarch;
-        let octaves = r
+        let compared = r
             .variants
             .iter()
-            .find(|v| v.0.lighting == Some(LightingModel::Octaves))
+            .find(|v| v.0.lighting == Some(COMPARED_MODEL))
             .map_or_else(
                 || "".to_string(),
                 |v| format!("{:.4} / {:.3}", v.1.flip_mean, v.1.luminance_ratio),
             );
         let _ = writeln!(
             s,
-            "| {} | {:.4} | {:.4} | {:.4} | {:.3} | {octaves} | {:.4} / {:.4} | {:.4} | {} | {:.0} |",
+            "| {} | {:.4} | {:.4} | {:.4} | {:.3} | {compared} | {:.4} / {:.4} | {:.4} | {} | {:.0} |",
             r.canonical.title,
             c.flip_mean,
             c.flip_p95,
@@ -288,7 +288,7 @@ pub fn chart_series(rows: &[Row]) -> Vec<ChartSeries> {
         .map(|(i, variant)| ChartSeries {
             label: variant.label(),
             family: match (variant.technique, variant.lighting) {
-                (Technique::Raymarch, Some(LightingModel::Octaves)) => 3,
+                (Technique::Raymarch, Some(COMPARED_MODEL)) => 3,
                 (Technique::Raymarch, _) => 0,
                 (Technique::Particles, _) => 1,
                 (Technique::Sprites, _) => 2,

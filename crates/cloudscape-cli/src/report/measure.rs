@@ -28,13 +28,18 @@ pub struct Variant {
 /// footprint as the path tracer does (the ray marcher does so within its march).
 const RASTER_FOOTPRINT_SAMPLES: u32 = 8;
 
+/// The ray marcher's model of multiple scattering the report sets beside the scenes' own: the
+/// δ-Eddington slab along the sun, which the light volume replaced.
+pub const COMPARED_MODEL: LightingModel = LightingModel::Slab;
+
 /// The quality presets from fast to converged.
 const PRESETS: [Quality; 4] = [Quality::Low, Quality::Medium, Quality::High, Quality::Ultra];
 
 impl Variant {
     /// Every variant the report measures: the ray marcher at each preset, the ray marcher with
-    /// the octave model at the scene's preset (the model the slab replaced), then the particles
-    /// and the sprites (only the ray marcher reads `render.quality` and `lighting.model`).
+    /// [`COMPARED_MODEL`] at the scene's preset (the model the light volume replaced), then the
+    /// particles and the sprites (only the ray marcher reads `render.quality` and
+    /// `lighting.model`).
     pub fn all() -> Vec<Variant> {
         let technique = |technique| Variant {
             technique,
@@ -45,22 +50,22 @@ impl Variant {
             quality: Some(q),
             ..technique(Technique::Raymarch)
         });
-        let octaves = Variant {
-            lighting: Some(LightingModel::Octaves),
+        let compared = Variant {
+            lighting: Some(COMPARED_MODEL),
             ..technique(Technique::Raymarch)
         };
         let others = [Technique::Particles, Technique::Sprites].map(technique);
-        presets.into_iter().chain([octaves]).chain(others).collect()
+        presets.into_iter().chain([compared]).chain(others).collect()
     }
 
-    /// "raymarch high", "raymarch octaves", "particles".
+    /// "raymarch high", "raymarch slab", "particles".
     pub fn label(&self) -> String {
         let mut label = self.technique.name().to_string();
         if let Some(q) = self.quality {
             label += &format!(" {}", quality_name(q));
         }
-        if self.lighting == Some(LightingModel::Octaves) {
-            label += " octaves";
+        if self.lighting == Some(COMPARED_MODEL) {
+            label += " slab";
         }
         label
     }

@@ -115,10 +115,16 @@ impl SunSlab {
     /// cosine `cos_theta` between the view ray and the direction to the sun.
     pub fn scattering(&self, cos_theta: f32, tau_sun: f32, tau_back: f32) -> f32 {
         let slab = self.scaled(tau_sun, tau_back);
-        let single = self.lobes.eval(cos_theta) * (-tau_sun).exp();
         let (i0, i1) = diffuse_moments(&slab);
         let diffuse = (i0 + self.lobes.mean_cosine() * cos_theta * i1).max(0.0);
-        single + self.peak_beam(cos_theta, tau_sun) + self.diffuse_scale * diffuse
+        self.beam_scattering(cos_theta, tau_sun) + self.diffuse_scale * diffuse
+    }
+
+    /// The beam's part of [`SunSlab::scattering`]: single scattering, exact, and the forward
+    /// peak's light the beam still carries, scattered once more; what the march adds per sample
+    /// when the diffuse light comes from the light volume (`slab_beam_scattering`).
+    pub fn beam_scattering(&self, cos_theta: f32, tau_sun: f32) -> f32 {
+        self.lobes.eval(cos_theta) * (-tau_sun).exp() + self.peak_beam(cos_theta, tau_sun)
     }
 
     /// The light the forward peak scattered that the beam still carries at `tau_sun`,

@@ -78,7 +78,12 @@ fn slab_peak_beam(model: SlabModel, cos_theta: f32, tau_sun: f32) -> f32 {
 // tau_sun under the sunlit side and tau_back over the far one, cos_theta between the view ray and
 // the direction to the sun (SunSlab::scattering).
 fn slab_scattering(model: SlabModel, cos_theta: f32, tau_sun: f32, tau_back: f32) -> f32 {
-    let single = phase_eval(model.lobes, cos_theta) * exp(-tau_sun);
     let diffuse = slab_diffuse(model, tau_sun, tau_back, cos_theta);
-    return single + slab_peak_beam(model, cos_theta, tau_sun) + model.params.z * diffuse;
+    return slab_beam_scattering(model, cos_theta, tau_sun) + model.params.z * diffuse;
+}
+
+// Single scattering and the forward peak's beam: the part the march adds per sample when the
+// light volume holds the diffuse light (SunSlab::beam_scattering).
+fn slab_beam_scattering(model: SlabModel, cos_theta: f32, tau_sun: f32) -> f32 {
+    return phase_eval(model.lobes, cos_theta) * exp(-tau_sun) + slab_peak_beam(model, cos_theta, tau_sun);
 }

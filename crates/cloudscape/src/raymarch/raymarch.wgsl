@@ -64,7 +64,7 @@ fn march_sun_scattering(p: vec3<f32>, d: vec3<f32>, tau_sun: f32, jitter: f32) -
     let by_slab = slab_scattering(slab, cos_theta, tau_sun, march_back_optical_depth(p, march.back_steps, jitter));
     let factors = vec3<f32>(march.octave_attenuation, march.octave_contribution, march.octave_eccentricity);
     let by_octaves = phase_octaves(march.phase_lobes, factors, march.octaves, cos_theta, tau_sun);
-    let by_volume = phase_eval(march.phase_lobes, cos_theta) * exp(-tau_sun) + slab_peak_beam(slab, cos_theta, tau_sun);
+    let by_volume = slab_beam_scattering(slab, cos_theta, tau_sun);
     return select(select(by_octaves, by_slab, march.lighting_model == 0u), by_volume, march_reads_volume());
 }
 

@@ -567,7 +567,8 @@ pub struct Lighting {
     pub octave_contribution: f32,
     /// Octave eccentricity factor `c`, 0..1: each octave's phase anisotropy is scaled by `c^i`.
     pub octave_eccentricity: f32,
-    /// Scale of the light scattered from the sky and the ground into the cloud, 0..4.
+    /// Slab and octave models: scale of the light scattered from the sky and the ground into the
+    /// cloud, 0..4.
     pub ambient_scale: f32,
     /// Light volume: cells of each cascade along x and z, 8..256.
     pub volume_cells_horizontal: u32,
