@@ -310,12 +310,15 @@ fn environment_light_volume_uvw(p: vec3<f32>) -> vec3<f32> {
 
 // The diffuse light of the clouds at world point p scattered toward the eye along `toward_eye`
 // (unit), per unit scattering coefficient: I0 + g w . I1 of the light volume's δ-Eddington
-// solution, with I1 = 3 J (optics/slab.rs scatters its slab's diffuse field the same way). Zero
-// without a volume.
+// solution, with I1 = 3 J (optics/slab.rs scatters its slab's diffuse field the same way),
+// interpolated with the cells' weights (their optical thickness: a point in a cloud's edge reads
+// the cloud's cells more than the clear air beside them). Zero without a volume.
 fn environment_light_volume_diffuse(p: vec3<f32>, toward_eye: vec3<f32>) -> vec3<f32> {
     let uvw = environment_light_volume_uvw(p);
-    let radiance = textureSampleLevel(environment_light_volume, environment_linear, uvw, 0.0).rgb;
-    let current = textureSampleLevel(environment_light_volume, environment_linear, uvw + vec3<f32>(0.0, 0.0, 0.5), 0.0).xyz;
+    let weighted = textureSampleLevel(environment_light_volume, environment_linear, uvw, 0.0);
+    let weighted_current = textureSampleLevel(environment_light_volume, environment_linear, uvw + vec3<f32>(0.0, 0.0, 0.5), 0.0);
+    let radiance = weighted.rgb / max(weighted.a, 1e-6);
+    let current = weighted_current.xyz / max(weighted_current.a, 1e-6);
     let g = environment.light_volume.optics.w;
     let diffuse = radiance * max(1.0 + 3.0 * g * dot(current, toward_eye), 0.0);
     return select(vec3<f32>(0.0), diffuse, environment.light_volume.enabled == 1u);

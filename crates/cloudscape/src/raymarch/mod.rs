@@ -95,6 +95,9 @@ impl MarchSettings {
     }
 }
 
+/// The march's entry points: with the slab's or the octaves' light, and reading the light volume.
+const ENTRIES: [&str; 2] = ["march_clouds", "march_clouds_volume"];
+
 /// `March::lighting_model` of the light volume.
 const LIGHTING_MODEL_VOLUME: u32 = 2;
 
@@ -176,7 +179,7 @@ impl RaymarchRenderer {
     /// Builds the pipeline against the shared groups' layouts.
     pub fn new(ctx: &GpuContext, shared: &Shared) -> RaymarchRenderer {
         RaymarchRenderer {
-            pass: ComputePass::new(ctx, shared, "raymarch", &RAYMARCH_WGSL, &["march_clouds"]),
+            pass: ComputePass::new(ctx, shared, "raymarch", &RAYMARCH_WGSL, &ENTRIES),
             march: uniform_buffer(ctx, "raymarch settings", size_of::<MarchUniform>() as u64),
             stats: storage_buffer(ctx, "raymarch stats", STATS_BYTES),
             stats_readback: LateReadback::new(ctx, "raymarch stats readback", STATS_BYTES),
@@ -261,6 +264,7 @@ impl Technique for RaymarchRenderer {
                 .write_buffer(&self.march, 0, bytemuck::bytes_of(&self.settings));
         }
         self.ensure_sums(ctx, size.x * size.y);
+        let entry = ENTRIES[usize::from(self.reads_light_volume())];
         let (march, stats, sums, pass) = (&self.march, &self.stats, &self.sums, &self.pass);
         let output = targets.output;
         let group = self.group.get(
@@ -284,7 +288,7 @@ impl Technique for RaymarchRenderer {
         dispatch_2d_repeated(
             encoder,
             "raymarch",
-            pass.main(),
+            pass.pipeline(entry),
             &shared.bind_groups(pass.slots, group),
             (size, self.settings.samples_per_pixel),
             writes,

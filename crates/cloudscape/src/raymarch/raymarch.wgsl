@@ -48,24 +48,22 @@ struct MarchSum {
 
 // Rays stop once this little light gets through (VolumeCloud's threshold, peers.md).
 const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
-// Whether the diffuse light comes from the environment's light volume.
-fn march_reads_volume() -> bool {
-    return march.lighting_model == 2u;
-}
-
 // The sun's light scattered at p toward the eye along d, per unit sigma_s and unit irradiance, by
 // the scene's model of multiple scattering, with tau_sun the optical depth toward the sun. With the
-// light volume only single scattering and the forward peak's beam: the volume holds the rest.
-fn march_sun_scattering(p: vec3<f32>, d: vec3<f32>, tau_sun: f32, jitter: f32) -> f32 {
+// light volume (`reads_volume`, constant per entry point) only single scattering and the forward
+// peak's beam: the volume holds the rest.
+fn march_sun_scattering(p: vec3<f32>, d: vec3<f32>, tau_sun: f32, jitter: f32, reads_volume: bool) -> f32 {
     let cos_theta = dot(d, environment_sun_direction());
-    // Every model, chosen by select: lavapipe recompiles (and leaks) a shader that branches on a
-    // uniform alone at every upload. Only the slab marches back samples (back_steps = 0 else).
     let slab = SlabModel(march.phase_lobes, march.slab_params);
+    if reads_volume {
+        return slab_beam_scattering(slab, cos_theta, tau_sun);
+    }
+    // Both models, chosen by select: lavapipe recompiles (and leaks) a shader that branches on a
+    // uniform alone at every upload. Only the slab marches back samples (back_steps = 0 else).
     let by_slab = slab_scattering(slab, cos_theta, tau_sun, march_back_optical_depth(p, march.back_steps, jitter));
     let factors = vec3<f32>(march.octave_attenuation, march.octave_contribution, march.octave_eccentricity);
     let by_octaves = phase_octaves(march.phase_lobes, factors, march.octaves, cos_theta, tau_sun);
-    let by_volume = slab_beam_scattering(slab, cos_theta, tau_sun);
-    return select(select(by_octaves, by_slab, march.lighting_model == 0u), by_volume, march_reads_volume());
+    return select(by_octaves, by_slab, march.lighting_model == 0u);
 }
 
 // The coarse optical depths (up, down) from p at altitude h to the top and the bottom of the
@@ -103,10 +101,11 @@ struct MarchLight {
 // The diffuse light scattered at p toward the eye along d, per unit sigma_s: the light volume's,
 // or the sky's and the ground's through the two-stream column (the slab's and the octaves'
 // multiple scattering is in march_sun_scattering).
-fn march_diffuse(p: vec3<f32>, d: vec3<f32>, light: MarchLight) -> vec3<f32> {
-    let from_volume = environment_light_volume_diffuse(p, -d);
-    let from_column = march_ambient(march_column(p, field_altitude_m(p)), light);
-    return select(from_column, from_volume, march_reads_volume());
+fn march_diffuse(p: vec3<f32>, d: vec3<f32>, light: MarchLight, reads_volume: bool) -> vec3<f32> {
+    if reads_volume {
+        return environment_light_volume_diffuse(p, -d);
+    }
+    return march_ambient(march_column(p, field_altitude_m(p)), light);
 }
 
 // MarchLight at p. Looked up once per ray, where it enters the cloud shell (not where empty-space
@@ -158,7 +157,7 @@ fn march_first_stratum(t0: f32, t1: f32, n: u32, empty_until: f32) -> u32 {
 // L += T S_int; T *= exp(-sigma_t dt).
 // Samples in the leading empty stretch (march_empty_until) are skipped: they would read zero.
 // `volume` is the stretch inside voxel-grid boxes.
-fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volume: vec2<f32>) -> MarchResult {
+fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volume: vec2<f32>, reads_volume: bool) -> MarchResult {
     let n = march_step_count(t1 - t0);
     let albedo = march.albedo;
     var radiance = vec3<f32>(0.0);
@@ -184,8 +183,8 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
             continue;
         }
         let tau_sun = march_sun_optical_depth(p, march.light_steps, jitter);
-        let sun = march_sun_scattering(p, d, tau_sun, jitter) * light.sun;
-        let source = albedo * (sun + march_diffuse(p, d, light));
+        let sun = march_sun_scattering(p, d, tau_sun, jitter, reads_volume) * light.sun;
+        let source = albedo * (sun + march_diffuse(p, d, light, reads_volume));
         let step_transmittance = exp(-sigma_t * dt);
         radiance += transmittance * source * (1.0 - step_transmittance);
         distance_weighted += transmittance * (1.0 - step_transmittance) * distance(p, o);
@@ -219,8 +218,10 @@ fn march_ray_offset(px: vec2<u32>) -> f32 {
 // (LP_MAX_TGSI_LOOP_ITERATIONS, Mesa gallivm), which long grazing rays times several samples
 // exceed, and short invocations suit GPUs as well. The last sample writes radiance and
 // transmittance, and the transmittance-weighted cloud distance (0 where there is no cloud).
-@compute @workgroup_size(8, 8)
-fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
+// The lighting model is a constant of each entry point (march_clouds, march_clouds_volume), not a
+// uniform: the compiler drops the model a pipeline does not use, and lavapipe recompiles (and
+// leaks) a shader that branches on a uniform alone.
+fn march_texel(id: vec3<u32>, reads_volume: bool) {
     let px = id.xy + march.tile_origin;
     let divisor = frame.grid_divisor;
     let viewport = vec2<u32>(frame.viewport_px);
@@ -250,7 +251,7 @@ fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     if t0 < t1 {
         // Samples of one pixel are stratified: offsets s / spp from the pixel's ray offset.
         let jitter = fract(march_ray_offset(px) + f32(sample_index) / f32(spp));
-        let m = march_segment(o, d, t0, t1, jitter, volume);
+        let m = march_segment(o, d, t0, t1, jitter, volume, reads_volume);
         result = vec4<f32>(m.radiance, m.transmittance);
         distance_m = m.distance_m;
         atomicAdd(&march_stats[0], m.density_samples);
@@ -268,4 +269,16 @@ fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     atomicAdd(&march_stats[1], 1u);
     textureStore(cloud_out, vec2<i32>(px), result);
     textureStore(cloud_distance_out, vec2<i32>(px), vec4<f32>(distance_m, 0.0, 0.0, 0.0));
+}
+
+// The march with the slab's or the octaves' multiple scattering and the two-stream ambient light.
+@compute @workgroup_size(8, 8)
+fn march_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
+    march_texel(id, false);
+}
+
+// The march reading the environment's light volume for the diffuse light.
+@compute @workgroup_size(8, 8)
+fn march_clouds_volume(@builtin(global_invocation_id) id: vec3<u32>) {
+    march_texel(id, true);
 }

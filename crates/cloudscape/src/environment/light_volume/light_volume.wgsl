@@ -278,8 +278,14 @@ fn light_volume_relax_black_uncoupled(@builtin(global_invocation_id) id: vec3<u3
     light_volume_relax(id.xy, 1u, false);
 }
 
+// A cell's weight in the table's interpolation (read::interpolation_weight).
+fn light_volume_weight(extinction: f32, h: vec3<f32>) -> f32 {
+    return clamp(extinction * min(h.x, min(h.y, h.z)), LIGHT_VOLUME_MIN_WEIGHT, 1.0);
+}
+
 // The table the environment reads (Diffusion::relative_current): I0 per cell, and the current
-// J = -D grad I0 + B of luminance over I0's luminance.
+// J = -D grad I0 + B of luminance over I0's luminance, each times the cell's weight, which alpha
+// holds, so that filtering interpolates them weighted.
 @compute @workgroup_size(8, 8)
 fn light_volume_export(@builtin(global_invocation_id) id: vec3<u32>) {
     if !light_volume_in_cells(id.xy) {
@@ -306,8 +312,10 @@ fn light_volume_export(@builtin(global_invocation_id) id: vec3<u32>) {
         current[axis] = -volume_diffusion[i] * gradient + dot(light_volume_beam_current(i, axis), LIGHT_VOLUME_LUMINANCE);
     }
     let radiance = volume_radiance[i].rgb;
-    let relative = current / max(dot(radiance, LIGHT_VOLUME_LUMINANCE), 1e-12);
+    var relative = current / max(dot(radiance, LIGHT_VOLUME_LUMINANCE), 1e-12);
+    relative *= min(1.0, LIGHT_VOLUME_MAX_RELATIVE_CURRENT / max(length(relative), 1e-20));
+    let weight = light_volume_weight(volume_cells[i].w, h);
     let texel = vec3<u32>(c.x, c.y, c.z + v.cells.z * k);
-    textureStore(volume_table_out, texel, vec4<f32>(radiance, 1.0));
-    textureStore(volume_table_out, texel + vec3<u32>(0u, 0u, v.cells.z * v.cascades), vec4<f32>(relative, 0.0));
+    textureStore(volume_table_out, texel, vec4<f32>(radiance, 1.0) * weight);
+    textureStore(volume_table_out, texel + vec3<u32>(0u, 0u, v.cells.z * v.cascades), vec4<f32>(relative, 1.0) * weight);
 }

@@ -7,6 +7,19 @@ use super::{DiffuseOptics, LightVolumeGrid, LightVolumeSettings};
 use crate::field::CloudField;
 use glam::{UVec3, Vec3};
 
+/// Least weight of a cell in the table's interpolation: clear air among clear air still
+/// interpolates.
+pub const MIN_INTERPOLATION_WEIGHT: f32 = 0.02;
+
+/// A cell's weight when the table is interpolated: its scaled optical thickness across its
+/// smallest side, within [`MIN_INTERPOLATION_WEIGHT`]..1, so that a point in the edge of a cloud
+/// reads the cloud's cells rather than the clear air beside them, whose radiance mixes the light
+/// leaving the cloud with the sky's (`light_volume_weight`; the GPU filters the weighted values and
+/// their weights and divides).
+pub fn interpolation_weight(extinction_per_m: f32, cell_m: Vec3) -> f32 {
+    (extinction_per_m * cell_m.min_element()).clamp(MIN_INTERPOLATION_WEIGHT, 1.0)
+}
+
 /// Every cascade's problem and its solution.
 pub struct LightVolume {
     /// The cascades' problems, finest first.
@@ -52,14 +65,19 @@ impl LightVolume {
             - 0.5;
         let base = local.floor().as_uvec3().min(problem.cells - 1);
         let f = local - base.as_vec3();
-        let (mut radiance, mut current) = (Vec3::ZERO, Vec3::ZERO);
+        let (mut radiance, mut current, mut weights) = (Vec3::ZERO, Vec3::ZERO, 0.0);
         for corner in 0..8u32 {
             let step = UVec3::new(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
             let c = (base + step).min(problem.cells - 1);
-            let w = Vec3::select(step.cmpeq(UVec3::ONE).into(), f, Vec3::ONE - f).element_product();
-            radiance += w * solution.radiance[problem.index(c)];
+            let trilinear =
+                Vec3::select(step.cmpeq(UVec3::ONE).into(), f, Vec3::ONE - f).element_product();
+            let i = problem.index(c);
+            let w = trilinear * interpolation_weight(problem.inputs[i][3], problem.cascade.cell_m);
+            radiance += w * solution.radiance[i];
             current += w * problem.relative_current(solution, c);
+            weights += w;
         }
+        let (radiance, current) = (radiance / weights, current / weights);
         let g = problem.optics.mean_cosine;
         radiance * (1.0 + 3.0 * g * current.dot(toward_eye)).max(0.0)
     }

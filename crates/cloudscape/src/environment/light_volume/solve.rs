@@ -34,6 +34,12 @@ use std::f32::consts::PI;
 /// Most cells of a column: the length of the GPU solver's private arrays.
 pub const MAX_COLUMN_CELLS: u32 = 64;
 
+/// Longest current over radiance the table holds: the P1 radiance `I0 + w . I1`, `I1 = 3 J`, is
+/// non-negative in every direction only while `|I1| <= I0` (realizability). Thin sheets, where
+/// diffusion's gradients are poor, ask for more; without the bound the march's
+/// `I0 (1 + 3 g w . J / I0)` dropped to zero for eyes against the current.
+pub const MAX_RELATIVE_CURRENT: f32 = 1.0 / 3.0;
+
 /// Weights of luminance (ITU-R BT.709): the channel mix the limiter and the stored current use.
 pub const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
 
@@ -243,8 +249,8 @@ impl Diffusion {
     }
 
     /// The current `J = -D grad I0 + B` of cell `c` (luminance, central differences one-sided at
-    /// the faces) over its radiance's luminance: what the table stores beside `I0`
-    /// (`light_volume_export`).
+    /// the faces) over its radiance's luminance, at most [`MAX_RELATIVE_CURRENT`] long: what the
+    /// table stores beside `I0` (`light_volume_export`).
     pub fn relative_current(&self, field: &DiffuseField, c: UVec3) -> Vec3 {
         let i = self.index(c);
         let lum = |c: UVec3| field.radiance[self.index(c)].dot(LUMINANCE);
@@ -262,7 +268,7 @@ impl Diffusion {
             current[axis] = -field.diffusion_m[i] * gradient
                 + self.beam_current(field, i, axis).dot(LUMINANCE);
         }
-        current / lum(c).max(1e-12)
+        (current / lum(c).max(1e-12)).clamp_length_max(MAX_RELATIVE_CURRENT)
     }
 
     /// Diffuse power leaving the grid through its top and its bottom, `4 pi J . n` summed over

@@ -163,3 +163,47 @@ fn light_diffuses_sideways_out_of_a_lit_column() {
     assert!(glow(20) > 0.0);
 }
 
+
+#[test]
+fn debug_deck() {
+    use super::inputs::VolumeLight;
+    use super::{LightVolume, LightVolumeGrid, LightVolumeSettings};
+    let mut scene = Scene::default();
+    scene.layers[0].coverage = std::env::var("COV").map(|v| v.parse().unwrap()).unwrap_or(1.0);
+    scene.layers[0].thickness_m = 500.0;
+    scene.layers[0].bottom_m = 1000.0;
+    scene.layers[0].extinction_per_m = 0.05;
+    scene.layers[0].types = crate::scene::CloudTypeMix { stratus: 1.0, ..Default::default() };
+    scene.sun.elevation_deg = 40.0;
+    scene.sun.irradiance = 1.0;
+    scene.sun.color = [1.0, 1.0, 1.0];
+    scene.sky.model = crate::scene::SkyModel::Constant;
+    scene.sky.radiance = [0.0; 3];
+    scene.ground.enabled = false;
+    let field = crate::field::CloudField::new(&scene, std::path::Path::new(".")).unwrap();
+    let settings = LightVolumeSettings::from_scene(&scene);
+    let grid = LightVolumeGrid::new(&settings, &field, Vec3::ZERO);
+    let env = crate::environment::Environment::from_scene(&scene);
+    let viewed = crate::environment::ViewedEnvironment::new(&env, Vec3::ZERO);
+    let light = VolumeLight { environment: &viewed, ground_albedo: None, time_s: 0.0 };
+    let slab = scene.lighting.sun_slab(PhaseLobes::from_scene(&scene.phase));
+    let volume = LightVolume::solve(&grid, &settings, (&field, droplets()), &light);
+    let sun = env.sun.direction;
+    eprintln!("grid {:?}", grid.cascades[0]);
+    let (problem, solution) = &volume.cascades[0];
+    for y in 0..10 {
+        let i = problem.index(UVec3::new(24, y, 24));
+        eprintln!("cell y {y}: inputs {:?} I0 {:?} D {}", problem.inputs[i], solution.radiance[i], solution.diffusion_m[i]);
+    }
+    for k in 0..12 {
+        let p = Vec3::new(137.0 * k as f32, 1000.0 + 40.0 * k as f32, -91.0 * k as f32);
+        let sigma = field.extinction_per_m(p, 0.0);
+        let tau_sun = field.coarse_optical_depth((p, sun), (0.0, 3000.0, 1.0), (200, 0.5), 0.0);
+        let tau_back = field.coarse_optical_depth((p, -sun), (0.0, 3000.0, 1.0), (200, 0.5), 0.0);
+        let mu0 = sun.y;
+        let s = slab.scaled(tau_sun * mu0, tau_back * mu0);
+        let exact = crate::optics::slab::diffuse_moments(&ScaledSlab { incidence: mu0, ..s });
+        let v = volume.diffuse(p, Vec3::Y);
+        eprintln!("y {:.0} sigma {sigma:.4} tau_sun {tau_sun:.2} back {tau_back:.2}: volume I0(up) {:.4}  slab-1D I0 {:.4} I1 {:.4}", p.y, v.x, exact.0, exact.1);
+    }
+}
