@@ -627,7 +627,7 @@ impl Default for Lighting {
             volume_extent_m: 8000.0,
             volume_cascades: 2,
             volume_sweeps: 32,
-            volume_warm_sweeps: 4,
+            volume_warm_sweeps: 2,
             volume_beam_steps: 24,
         }
     }

@@ -6,6 +6,7 @@ use super::{DiffuseOptics, LightVolumeCascade, LightVolumeGrid, LightVolumeSetti
 use crate::environment::ViewedEnvironment;
 use crate::field::CloudField;
 use glam::{UVec3, Vec3};
+use rayon::prelude::*;
 use std::f32::consts::PI;
 
 /// Growth of the beam's segments from one to the next toward the sun: fine near the cell, where
@@ -41,20 +42,15 @@ pub fn diffusion(
     let cells = grid.cells;
     let top_m = cascade.min_m.y + cascade.cell_m.y * cells.y as f32;
     let sun = light.environment.env.sun.direction;
-    let mut inputs = Vec::with_capacity((cells.x * cells.y * cells.z) as usize);
-    for z in 0..cells.z {
-        for y in 0..cells.y {
-            for x in 0..cells.x {
-                let c = UVec3::new(x, y, z);
-                inputs.push(cell_inputs(
-                    (&cascade, c, top_m),
-                    settings.beam_steps,
-                    (field, optics),
-                    light,
-                ));
-            }
-        }
-    }
+    let count = cells.x * cells.y * cells.z;
+    let inputs: Vec<[f32; 4]> = (0..count)
+        .into_par_iter()
+        .map(|i| {
+            let c = UVec3::new(i % cells.x, (i / cells.x) % cells.y, i / (cells.x * cells.y));
+            let cell = (&cascade, c, top_m);
+            cell_inputs(cell, settings.beam_steps, (field, optics), light)
+        })
+        .collect();
     let environment = light.environment;
     let centre_top = cascade.centre(UVec3::new(cells.x / 2, cells.y - 1, cells.z / 2));
     Diffusion {
