@@ -859,7 +859,11 @@ fn the_light_volume_matches_the_cpu() {
         ground_albedo: FrameSettings::from_scene(&scene).ground_albedo,
         time_s: frame.time_s,
     };
-    let optics = DiffuseOptics::of(&scene.lighting.sun_slab(PhaseLobes::from_scene(&scene.phase)));
+    let optics = DiffuseOptics::of(
+        &scene
+            .lighting
+            .sun_slab(PhaseLobes::from_scene(&scene.phase)),
+    );
     let volume = LightVolume::solve(&grid, &settings, (clouds.field(), optics), &light);
     let (low, high) = (grid.cascades[0].min_m.y, grid.cascades[0].min_m.y + 1500.0);
     let inputs: Vec<ProbeInput> = (0..240)
@@ -886,6 +890,9 @@ fn the_light_volume_matches_the_cpu() {
         let error = (g.truncate() - *w).abs().max_element() / scale;
         assert!(error <= 0.03, "#{i} at {}: GPU {g} vs CPU {w}", inputs[i].a);
     }
-    let lit = want.iter().filter(|w| w.max_element() > 0.1 * scale).count();
+    let lit = want
+        .iter()
+        .filter(|w| w.max_element() > 0.1 * scale)
+        .count();
     assert!(lit > 40, "most points see diffuse light ({lit})");
 }

@@ -78,7 +78,12 @@ pub fn run(args: FitLightingArgs) -> Result<()> {
             score(&model, &validation),
         );
     }
-    print_classes(lighting.sun_slab(lobes), fitted_slab, &training, &validation);
+    print_classes(
+        lighting.sun_slab(lobes),
+        fitted_slab,
+        &training,
+        &validation,
+    );
     println!(
         "\n[lighting]\nslab_diffuse_scale = {:.3}\nslab_back_scale = {:.3}\noctave_attenuation = {:.3}\noctave_contribution = {:.3}\noctave_eccentricity = {:.3}",
         fitted_slab.diffuse_scale,
@@ -92,7 +97,12 @@ pub fn run(args: FitLightingArgs) -> Result<()> {
 
 /// Per class of point, over every scene's points in the light volume's finest cascade: each
 /// model's mean prediction over the path tracer's mean source.
-fn print_classes(slab: cloudscape::optics::SunSlab, fitted: cloudscape::optics::SunSlab, training: &[Sample], validation: &[Sample]) {
+fn print_classes(
+    slab: cloudscape::optics::SunSlab,
+    fitted: cloudscape::optics::SunSlab,
+    training: &[Sample],
+    validation: &[Sample],
+) {
     let inside: Vec<Sample> = training
         .iter()
         .chain(validation)

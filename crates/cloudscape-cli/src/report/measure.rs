@@ -55,7 +55,11 @@ impl Variant {
             ..technique(Technique::Raymarch)
         };
         let others = [Technique::Particles, Technique::Sprites].map(technique);
-        presets.into_iter().chain([compared]).chain(others).collect()
+        presets
+            .into_iter()
+            .chain([compared])
+            .chain(others)
+            .collect()
     }
 
     /// "raymarch high", "raymarch slab", "particles".

@@ -1,6 +1,7 @@
 //! The environment on the GPU: its uniform, the atmosphere's tables, the clouds' shadow map and
 //! the light volume in one bind group ([`crate::shader::ENVIRONMENT_GROUP`]), as `environment.wgsl` declares them.
 
+use super::light_volume::{DiffuseOptics, LightVolumeGrid, LightVolumeSettings, MAX_CASCADES};
 use super::{Environment, SkyModel};
 use crate::atmosphere::Air;
 use crate::atmosphere::luts::{
@@ -9,7 +10,6 @@ use crate::atmosphere::luts::{
 };
 use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{UNIFORM, bind_group, bind_group_layout, float_texture, uniform_buffer};
-use super::light_volume::{DiffuseOptics, LightVolumeGrid, LightVolumeSettings, MAX_CASCADES};
 use crate::shadow::ShadowParams;
 use bytemuck::{Pod, Zeroable};
 use glam::{UVec3, Vec2, Vec3, Vec4};
@@ -413,7 +413,9 @@ impl EnvironmentGpu {
     fn storage_views(&self, table: EnvironmentTable) -> Vec<wgpu::TextureView> {
         let texture = &self.textures[table.bindings()[0] - 1];
         match table {
-            EnvironmentTable::Irradiance | EnvironmentTable::Aerial | EnvironmentTable::CloudShadow => (0..2)
+            EnvironmentTable::Irradiance
+            | EnvironmentTable::Aerial
+            | EnvironmentTable::CloudShadow => (0..2)
                 .map(|layer| {
                     texture.create_view(&wgpu::TextureViewDescriptor {
                         dimension: Some(wgpu::TextureViewDimension::D2),

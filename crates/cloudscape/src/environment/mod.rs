@@ -23,15 +23,15 @@
 
 mod atmosphere_passes;
 mod gpu;
+pub mod light_volume;
 mod passes;
 mod shadow_pass;
-pub mod light_volume;
 mod table_pass;
 
 pub use atmosphere_passes::{ATMOSPHERE_AERIAL_WGSL, ATMOSPHERE_LUTS_WGSL, ATMOSPHERE_MARCH_WGSL};
 pub use gpu::{
-    AirUniform, CloudShadowUniform, ENVIRONMENT_WGSL, EnvironmentGpu, EnvironmentTable, LightVolumeUniform, TableSizes,
-    EnvironmentUniform, TABLE_FORMAT,
+    AirUniform, CloudShadowUniform, ENVIRONMENT_WGSL, EnvironmentGpu, EnvironmentTable,
+    EnvironmentUniform, LightVolumeUniform, TABLE_FORMAT, TableSizes,
 };
 pub use passes::{EnvironmentPasses, FrameLightVolume};
 pub use shadow_pass::CLOUD_SHADOW_WGSL;

@@ -40,7 +40,8 @@ mod tests {
         let field = crate::field::CloudField::new(&scene, Path::new(".")).unwrap();
         let field_gpu = crate::field::gpu::FieldGpu::new(&ctx, &field);
         let frame = crate::frame::FrameGpu::new(&ctx, "frame");
-        let environment = crate::environment::EnvironmentGpu::new(&ctx, crate::environment::TableSizes::SMALLEST);
+        let environment =
+            crate::environment::EnvironmentGpu::new(&ctx, crate::environment::TableSizes::SMALLEST);
         let shared = Shared {
             field: &field_gpu,
             frame: &frame,

@@ -22,11 +22,11 @@ use crate::field::{CloudField, FieldError};
 use crate::frame::{Frame, FrameGpu, FrameSettings};
 use crate::gpu::pipeline::{STORAGE_OUTPUT, texture_2d};
 use crate::gpu::{GpuContext, PassTimer};
+use crate::optics::PhaseLobes;
 use crate::output::{CloudOutput, SampleGrid};
 use crate::pass::Shared;
 use crate::post::upsample::Upsampler;
 use crate::post::{Background, Compositor, DISPLAY_FORMAT, Display, HDR_FORMAT};
-use crate::optics::PhaseLobes;
 use crate::scene::Scene;
 use crate::shadow::{BuiltShadow, ShadowParams, ShadowReuse};
 use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
@@ -471,8 +471,13 @@ impl CloudRenderer {
         };
         let groups = (&shared, &self.environment_gpu);
         let volume = self.light_volume.as_ref().map(|(g, s)| (g, s));
-        self.environment_passes
-            .encode(ctx, encoder, groups, (env, self.shadow_rebuild, volume), timer);
+        self.environment_passes.encode(
+            ctx,
+            encoder,
+            groups,
+            (env, self.shadow_rebuild, volume),
+            timer,
+        );
         *pending = false;
     }
 

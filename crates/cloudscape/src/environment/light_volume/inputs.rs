@@ -46,7 +46,11 @@ pub fn diffusion(
     let inputs: Vec<[f32; 4]> = (0..count)
         .into_par_iter()
         .map(|i| {
-            let c = UVec3::new(i % cells.x, (i / cells.x) % cells.y, i / (cells.x * cells.y));
+            let c = UVec3::new(
+                i % cells.x,
+                (i / cells.x) % cells.y,
+                i / (cells.x * cells.y),
+            );
             let cell = (&cascade, c, top_m);
             cell_inputs(cell, settings.beam_steps, (field, optics), light)
         })

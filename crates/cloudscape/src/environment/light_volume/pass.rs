@@ -1,7 +1,7 @@
 //! The light volume's passes (`light_volume.wgsl`): the cells' inputs, the sweeps of the solve
 //! (warm-started while the grid stays put), and the table the environment reads.
 
-use super::inputs::{BEAM_GROWTH, BEAM_PATH_MAX_M, BEAM_MIN_SUN_Y, CELL_SAMPLE_OFFSET};
+use super::inputs::{BEAM_GROWTH, BEAM_MIN_SUN_Y, BEAM_PATH_MAX_M, CELL_SAMPLE_OFFSET};
 use super::solve::MAX_COLUMN_CELLS;
 use super::{LightVolumeGrid, LightVolumeSettings};
 use crate::environment::{EnvironmentGpu, EnvironmentTable};
@@ -11,8 +11,11 @@ use crate::pass::{BindGroupCache, ComputePass, Shared};
 use glam::UVec2;
 
 /// Labels the passes are timed under: the cells' inputs, the solve's sweeps, the table.
-pub const LIGHT_VOLUME_PASS_NAMES: [&str; 3] =
-    ["light volume cells", "light volume solve", "light volume table"];
+pub const LIGHT_VOLUME_PASS_NAMES: [&str; 3] = [
+    "light volume cells",
+    "light volume solve",
+    "light volume table",
+];
 
 const ENTRIES: [&str; 7] = [
     "light_volume_cells",
@@ -59,7 +62,11 @@ impl LightVolumePass {
         {
             return false;
         }
-        let labels = ["light volume cells", "light volume radiance", "light volume diffusion"];
+        let labels = [
+            "light volume cells",
+            "light volume radiance",
+            "light volume diffusion",
+        ];
         self.buffers = Some([0, 1, 2].map(|i| storage_buffer(ctx, labels[i], bytes[i])));
         self.group.clear();
         true
@@ -97,7 +104,10 @@ impl LightVolumePass {
                     ("volume_cells", buffers[0].as_entire_binding()),
                     ("volume_radiance", buffers[1].as_entire_binding()),
                     ("volume_diffusion", buffers[2].as_entire_binding()),
-                    ("volume_table_out", wgpu::BindingResource::TextureView(&views[0])),
+                    (
+                        "volume_table_out",
+                        wgpu::BindingResource::TextureView(&views[0]),
+                    ),
                 ],
             )
         });
@@ -121,7 +131,9 @@ impl LightVolumePass {
         }
         let [cells_name, solve_name, table_name] = LIGHT_VOLUME_PASS_NAMES;
         let mut record = |label, steps: &[(&str, UVec2)]| {
-            let writes = timer.as_deref_mut().and_then(|t| t.compute_pass_writes(label));
+            let writes = timer
+                .as_deref_mut()
+                .and_then(|t| t.compute_pass_writes(label));
             let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(label),
                 timestamp_writes: writes,
@@ -165,7 +177,13 @@ fn light_volume_constants() -> String {
         ("LIGHT_VOLUME_BEAM_PATH_MAX_M", F32(BEAM_PATH_MAX_M)),
         ("LIGHT_VOLUME_BEAM_MIN_SUN_Y", F32(BEAM_MIN_SUN_Y)),
         ("LIGHT_VOLUME_MAX_COLUMN_CELLS", U32(MAX_COLUMN_CELLS)),
-        ("LIGHT_VOLUME_MAX_RELATIVE_CURRENT", F32(super::solve::MAX_RELATIVE_CURRENT)),
-        ("LIGHT_VOLUME_MIN_WEIGHT", F32(super::read::MIN_INTERPOLATION_WEIGHT)),
+        (
+            "LIGHT_VOLUME_MAX_RELATIVE_CURRENT",
+            F32(super::solve::MAX_RELATIVE_CURRENT),
+        ),
+        (
+            "LIGHT_VOLUME_MIN_WEIGHT",
+            F32(super::read::MIN_INTERPOLATION_WEIGHT),
+        ),
     ])
 }

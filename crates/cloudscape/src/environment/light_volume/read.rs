@@ -70,7 +70,7 @@ impl LightVolume {
             let step = UVec3::new(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
             let c = (base + step).min(problem.cells - 1);
             let trilinear =
-                Vec3::select(step.cmpeq(UVec3::ONE).into(), f, Vec3::ONE - f).element_product();
+                Vec3::select(step.cmpeq(UVec3::ONE), f, Vec3::ONE - f).element_product();
             let i = problem.index(c);
             let w = trilinear * interpolation_weight(problem.inputs[i][3], problem.cascade.cell_m);
             radiance += w * solution.radiance[i];

@@ -147,7 +147,10 @@ impl Diffusion {
         let mut gradient = Vec3::ZERO;
         let mut brightest = lum(c);
         for axis in 0..3 {
-            let (lo, hi) = (c[axis].saturating_sub(1), (c[axis] + 1).min(self.cells[axis] - 1));
+            let (lo, hi) = (
+                c[axis].saturating_sub(1),
+                (c[axis] + 1).min(self.cells[axis] - 1),
+            );
             let (mut a, mut b) = (c, c);
             a[axis] = lo;
             b[axis] = hi;
@@ -198,7 +201,8 @@ impl Diffusion {
                     let mut nc = c;
                     nc[axis] = n as u32;
                     let j = self.index(nc);
-                    let face_b = 0.5 * (self.beam_current(field, i, axis) + self.beam_current(field, j, axis));
+                    let face_b = 0.5
+                        * (self.beam_current(field, i, axis) + self.beam_current(field, j, axis));
                     rhs[y] -= step as f32 * face_b / h[axis];
                     if coupled {
                         let a = harmonic(d, field.diffusion_m[j]) / (h[axis] * h[axis]);
@@ -258,7 +262,10 @@ impl Diffusion {
         let lum = |c: UVec3| field.radiance[self.index(c)].dot(LUMINANCE);
         let mut current = Vec3::ZERO;
         for axis in 0..3 {
-            let (lo, hi) = (c[axis].saturating_sub(1), (c[axis] + 1).min(self.cells[axis] - 1));
+            let (lo, hi) = (
+                c[axis].saturating_sub(1),
+                (c[axis] + 1).min(self.cells[axis] - 1),
+            );
             let (mut a, mut b) = (c, c);
             a[axis] = lo;
             b[axis] = hi;
@@ -267,8 +274,8 @@ impl Diffusion {
             } else {
                 0.0
             };
-            current[axis] = -field.diffusion_m[i] * gradient
-                + self.beam_current(field, i, axis).dot(LUMINANCE);
+            current[axis] =
+                -field.diffusion_m[i] * gradient + self.beam_current(field, i, axis).dot(LUMINANCE);
         }
         (current / lum(c).max(1e-12)).clamp_length_max(MAX_RELATIVE_CURRENT)
     }
@@ -306,7 +313,10 @@ impl Diffusion {
                 let beam = Vec3::new(self.inputs[i][0], self.inputs[i][1], self.inputs[i][2]);
                 let direct = beam * (-self.beam_direction.y).max(0.0);
                 let denominator = Vec3::ONE + albedo;
-                (2.0 * albedo / denominator, albedo * direct / (PI * denominator))
+                (
+                    2.0 * albedo / denominator,
+                    albedo * direct / (PI * denominator),
+                )
             }
         }
     }
@@ -333,7 +343,11 @@ fn thomas(lower: &[f32], diag: &[Vec3], upper: &[f32], rhs: &[Vec3]) -> Vec<Vec3
     let mut c = vec![Vec3::ZERO; n];
     let mut d = vec![Vec3::ZERO; n];
     for i in 0..n {
-        let (prev_c, prev_d) = if i > 0 { (c[i - 1], d[i - 1]) } else { (Vec3::ZERO, Vec3::ZERO) };
+        let (prev_c, prev_d) = if i > 0 {
+            (c[i - 1], d[i - 1])
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
+        };
         let m = diag[i] - lower[i] * prev_c;
         c[i] = upper[i] / m;
         d[i] = (rhs[i] - lower[i] * prev_d) / m;

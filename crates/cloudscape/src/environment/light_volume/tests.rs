@@ -10,7 +10,11 @@ use glam::{UVec3, Vec3};
 
 fn droplets() -> DiffuseOptics {
     let scene = Scene::default();
-    DiffuseOptics::of(&scene.lighting.sun_slab(PhaseLobes::from_scene(&scene.phase)))
+    DiffuseOptics::of(
+        &scene
+            .lighting
+            .sun_slab(PhaseLobes::from_scene(&scene.phase)),
+    )
 }
 
 fn dark() -> Boundaries {
@@ -92,11 +96,16 @@ fn blob() -> (Diffusion, f32) {
             let mut beam = 1.0f32;
             incident += beam * h * h;
             for y in (0..n).rev() {
-                let r = (UVec3::new(x, y, z).as_vec3() + 0.5 - n as f32 / 2.0).length() / (n as f32 / 3.0);
+                let r = (UVec3::new(x, y, z).as_vec3() + 0.5 - n as f32 / 2.0).length()
+                    / (n as f32 / 3.0);
                 let sigma = 0.03 * (-r * r).exp();
                 let out = beam * (-sigma * h).exp();
                 // The beam's loss over the cell, as an irradiance at its centre that sigma h scatters.
-                let mean = if sigma > 0.0 { (beam - out) / (sigma * h) } else { beam };
+                let mean = if sigma > 0.0 {
+                    (beam - out) / (sigma * h)
+                } else {
+                    beam
+                };
                 inputs[(x + n * (y + n * z)) as usize] = [mean, mean, mean, sigma];
                 beam = out;
             }
@@ -159,8 +168,10 @@ fn light_diffuses_sideways_out_of_a_lit_column() {
         problem.solve(&mut field, sweeps, true);
         field.radiance[neighbour].x
     };
-    assert_eq!(glow(1), 0.0, "the first sweep of a cold start keeps columns apart");
+    assert_eq!(
+        glow(1),
+        0.0,
+        "the first sweep of a cold start keeps columns apart"
+    );
     assert!(glow(20) > 0.0);
 }
-
-
