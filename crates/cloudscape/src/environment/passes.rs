@@ -18,8 +18,9 @@ pub struct EnvironmentPasses {
     light_volume: LightVolumePass,
 }
 
-/// The light volume a frame solves: its grid and settings.
-pub type FrameLightVolume<'a> = (&'a LightVolumeGrid, &'a LightVolumeSettings);
+/// The light volume a frame solves: its grid, its settings, and whether it may start from the
+/// last frame's solution.
+pub type FrameLightVolume<'a> = (&'a LightVolumeGrid, &'a LightVolumeSettings, bool);
 
 impl EnvironmentPasses {
     /// Builds the pipelines against the shared groups.
@@ -44,11 +45,6 @@ impl EnvironmentPasses {
             names.extend(LIGHT_VOLUME_PASS_NAMES);
         }
         names
-    }
-
-    /// The light volume's pass (its buffers, for tests).
-    pub fn light_volume(&self) -> &LightVolumePass {
-        &self.light_volume
     }
 
     /// Records the frame's passes for `env` (the uniform already written) into the environment's

@@ -140,8 +140,10 @@ pub struct CloudRenderer {
     shadow_reuse: Option<ShadowReuse>,
     shadow_built: Option<BuiltShadow>,
     shadow_rebuild: bool,
-    /// The light volume of the frame begun, when the technique reads one.
-    light_volume: Option<(LightVolumeGrid, LightVolumeSettings)>,
+    /// The light volume of the frame begun, when the technique reads one, and whether it may start
+    /// from the last frame's solution (only with temporal reuse: a frame without history is a
+    /// still, the same whatever was drawn before).
+    light_volume: Option<(LightVolumeGrid, LightVolumeSettings, bool)>,
 }
 
 impl CloudRenderer {
@@ -354,7 +356,7 @@ impl CloudRenderer {
         self.light_volume = self.technique.reads_light_volume().then(|| {
             let settings = LightVolumeSettings::from_scene(&self.settings);
             let grid = LightVolumeGrid::new(&settings, &self.field, frame.camera_position_m);
-            (grid, settings)
+            (grid, settings, matches!(reuse, Reuse::Temporal(_)))
         });
         let uniform = EnvironmentUniform::new(&env, frame.camera_position_m, &shadow)
             .with_light_volume(self.light_volume_uniform());
@@ -399,7 +401,9 @@ impl CloudRenderer {
         let s = &self.settings;
         let optics = DiffuseOptics::of(&s.lighting.sun_slab(PhaseLobes::from_scene(&s.phase)));
         let volume = self.light_volume.as_ref();
-        LightVolumeUniform::new(volume.map(|(grid, settings)| (grid, optics, settings.beam_steps)))
+        LightVolumeUniform::new(
+            volume.map(|(grid, settings, _)| (grid, optics, settings.beam_steps)),
+        )
     }
 
     /// The wind of the first layer, which carries the clouds (zero without layers).
@@ -470,7 +474,7 @@ impl CloudRenderer {
             environment: &self.environment_gpu,
         };
         let groups = (&shared, &self.environment_gpu);
-        let volume = self.light_volume.as_ref().map(|(g, s)| (g, s));
+        let volume = self.light_volume.as_ref().map(|(g, s, warm)| (g, s, *warm));
         self.environment_passes.encode(
             ctx,
             encoder,

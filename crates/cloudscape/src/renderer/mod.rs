@@ -284,6 +284,7 @@ pub static PROGRAMS: &[&crate::shader::WgslModule] = &[
     &crate::environment::ATMOSPHERE_LUTS_WGSL,
     &crate::environment::ATMOSPHERE_AERIAL_WGSL,
     &crate::environment::CLOUD_SHADOW_WGSL,
+    &crate::environment::light_volume::LIGHT_VOLUME_WGSL,
     &crate::raymarch::RAYMARCH_WGSL,
     &crate::temporal::TEMPORAL_WGSL,
     &crate::post::upsample::UPSAMPLE_STILL_WGSL,

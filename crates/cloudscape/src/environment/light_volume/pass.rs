@@ -47,11 +47,6 @@ impl LightVolumePass {
         }
     }
 
-    /// The buffer of per-cell radiance (`vec4<f32>`, I0 in rgb), for tests.
-    pub fn radiance_buffer(&self) -> Option<&wgpu::Buffer> {
-        self.buffers.as_ref().map(|b| &b[1])
-    }
-
     /// Makes the buffers hold `cells` cells; true when they were remade (and hold nothing).
     fn ensure_buffers(&mut self, ctx: &GpuContext, cells: u64) -> bool {
         let bytes = [16 * cells, 16 * cells, 4 * cells];
@@ -73,14 +68,14 @@ impl LightVolumePass {
     }
 
     /// Records the frame's volume for `grid` (the environment's uniform already holds it): a cold
-    /// solve of `settings.sweeps` sweeps when the grid is new or moved, else `warm_sweeps` from
-    /// the last solution.
+    /// solve of `settings.sweeps` sweeps when the grid is new or moved or the frame may not start
+    /// warm, else `warm_sweeps` from the last solution.
     pub fn encode(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         (shared, environment): (&Shared, &EnvironmentGpu),
-        (grid, settings): (&LightVolumeGrid, &LightVolumeSettings),
+        (grid, settings, may_start_warm): (&LightVolumeGrid, &LightVolumeSettings, bool),
         mut timer: Option<&mut PassTimer>,
     ) {
         assert!(
@@ -90,7 +85,7 @@ impl LightVolumePass {
         let cascades = grid.cascades.len() as u32;
         let cells = u64::from(grid.cells.element_product() * cascades);
         let remade = self.ensure_buffers(ctx, cells);
-        let cold = remade || self.solved.as_ref() != Some(grid);
+        let cold = remade || !may_start_warm || self.solved.as_ref() != Some(grid);
         let buffers = self.buffers.as_ref().expect("made above");
         if cold {
             encoder.clear_buffer(&buffers[1], 0, None);
