@@ -91,17 +91,11 @@ fn light_volume_flux_limited(transport: f32, relative: f32) -> f32 {
     return 1.0 / max(max(3.0 * transport, relative), 1e-30);
 }
 
-// The flux-limited diffusion coefficient of every cell from the radiance's luminance gradient over
-// the brightest cell it reads (Diffusion::limited_diffusion).
-@compute @workgroup_size(8, 8)
-fn light_volume_limit(@builtin(global_invocation_id) id: vec3<u32>) {
-    if !light_volume_in_cells(id.xy) {
-        return;
-    }
+// The gradient of the radiance's luminance at cell c of cascade k (central differences, one-sided
+// at the faces) in xyz, and the largest luminance of the cells it reads in w
+// (Diffusion::luminance_gradient).
+fn light_volume_gradient(c: vec3<u32>, k: u32) -> vec4<f32> {
     let v = environment.light_volume;
-    let ck = light_volume_cell_of(id.xy);
-    let c = ck.xyz;
-    let k = ck.w;
     let h = v.cascade_cell_m[k].xyz;
     var gradient = vec3<f32>(0.0);
     var brightest = light_volume_luminance(c, k);
@@ -117,8 +111,23 @@ fn light_volume_limit(@builtin(global_invocation_id) id: vec3<u32>) {
             gradient[axis] = (light_volume_luminance(b, k) - light_volume_luminance(a, k)) / (f32(hi_i - lo_i) * h[axis]);
         }
     }
-    let relative = length(gradient) / max(brightest, 1e-12);
-    let height_m = h.y * f32(v.cells.y);
+    return vec4<f32>(gradient, brightest);
+}
+
+// The flux-limited diffusion coefficient of every cell from the radiance's luminance gradient over
+// the brightest cell it reads (Diffusion::limited_diffusion).
+@compute @workgroup_size(8, 8)
+fn light_volume_limit(@builtin(global_invocation_id) id: vec3<u32>) {
+    if !light_volume_in_cells(id.xy) {
+        return;
+    }
+    let v = environment.light_volume;
+    let ck = light_volume_cell_of(id.xy);
+    let c = ck.xyz;
+    let k = ck.w;
+    let gradient = light_volume_gradient(c, k);
+    let relative = length(gradient.xyz) / max(gradient.w, 1e-12);
+    let height_m = v.cascade_cell_m[k].y * f32(v.cells.y);
     let extinction = volume_cells[light_volume_index(c, k)].w;
     volume_diffusion[light_volume_index(c, k)] = min(light_volume_flux_limited(light_volume_transport(extinction), relative), height_m);
 }
@@ -297,20 +306,11 @@ fn light_volume_export(@builtin(global_invocation_id) id: vec3<u32>) {
     let k = ck.w;
     let i = light_volume_index(c, k);
     let h = v.cascade_cell_m[k].xyz;
-    var current = vec3<f32>(0.0);
+    var beam = vec3<f32>(0.0);
     for (var axis = 0u; axis < 3u; axis++) {
-        let lo_i = max(c[axis], 1u) - 1u;
-        let hi_i = min(c[axis] + 1u, v.cells[axis] - 1u);
-        var a = c;
-        var b = c;
-        a[axis] = lo_i;
-        b[axis] = hi_i;
-        var gradient = 0.0;
-        if hi_i > lo_i {
-            gradient = (light_volume_luminance(b, k) - light_volume_luminance(a, k)) / (f32(hi_i - lo_i) * h[axis]);
-        }
-        current[axis] = -volume_diffusion[i] * gradient + dot(light_volume_beam_current(i, axis), LIGHT_VOLUME_LUMINANCE);
+        beam[axis] = dot(light_volume_beam_current(i, axis), LIGHT_VOLUME_LUMINANCE);
     }
+    let current = -volume_diffusion[i] * light_volume_gradient(c, k).xyz + beam;
     let radiance = volume_radiance[i].rgb;
     var relative = current / max(dot(radiance, LIGHT_VOLUME_LUMINANCE), 1e-12);
     relative *= min(1.0, LIGHT_VOLUME_MAX_RELATIVE_CURRENT / max(length(relative), 1e-20));

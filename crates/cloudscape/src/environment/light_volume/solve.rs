@@ -137,13 +137,20 @@ impl Diffusion {
     }
 
     /// The flux-limited diffusion coefficient of cell `c` from the radiance's luminance gradient
-    /// (central differences, one-sided at the faces) over the largest luminance of the cells the
-    /// gradient reads (the cell's own lags behind a sweep: a dark cell beside a lit one would
-    /// get no diffusion at all and gather the light it should pass on), at most the grid's
-    /// height.
+    /// over the largest luminance of the cells the gradient reads (the cell's own lags behind a
+    /// sweep: a dark cell beside a lit one would get no diffusion at all and gather the light it
+    /// should pass on), at most the grid's height.
     pub fn limited_diffusion(&self, field: &DiffuseField, c: UVec3) -> f32 {
+        let (gradient, brightest) = self.luminance_gradient(field, c);
+        let relative = gradient.length() / brightest.max(1e-12);
+        let height_m = self.cascade.cell_m.y * self.cells.y as f32;
+        flux_limited_diffusion(self.transport(self.index(c)), relative).min(height_m)
+    }
+
+    /// The gradient of the radiance's luminance at cell `c` (central differences, one-sided at
+    /// the faces), and the largest luminance of the cells it reads (`light_volume_gradient`).
+    fn luminance_gradient(&self, field: &DiffuseField, c: UVec3) -> (Vec3, f32) {
         let lum = |c: UVec3| field.radiance[self.index(c)].dot(LUMINANCE);
-        let h = self.cascade.cell_m;
         let mut gradient = Vec3::ZERO;
         let mut brightest = lum(c);
         for axis in 0..3 {
@@ -156,12 +163,11 @@ impl Diffusion {
             b[axis] = hi;
             brightest = brightest.max(lum(a)).max(lum(b));
             if hi > lo {
-                gradient[axis] = (lum(b) - lum(a)) / ((hi - lo) as f32 * h[axis]);
+                let h = (hi - lo) as f32 * self.cascade.cell_m[axis];
+                gradient[axis] = (lum(b) - lum(a)) / h;
             }
         }
-        let relative = gradient.length() / brightest.max(1e-12);
-        let height_m = h.y * self.cells.y as f32;
-        flux_limited_diffusion(self.transport(self.index(c)), relative).min(height_m)
+        (gradient, brightest)
     }
 
     /// The beam's current `B` in cell `i` per unit irradiance, times the irradiance per channel
@@ -259,25 +265,13 @@ impl Diffusion {
     /// table stores beside `I0` (`light_volume_export`).
     pub fn relative_current(&self, field: &DiffuseField, c: UVec3) -> Vec3 {
         let i = self.index(c);
-        let lum = |c: UVec3| field.radiance[self.index(c)].dot(LUMINANCE);
-        let mut current = Vec3::ZERO;
-        for axis in 0..3 {
-            let (lo, hi) = (
-                c[axis].saturating_sub(1),
-                (c[axis] + 1).min(self.cells[axis] - 1),
-            );
-            let (mut a, mut b) = (c, c);
-            a[axis] = lo;
-            b[axis] = hi;
-            let gradient = if hi > lo {
-                (lum(b) - lum(a)) / ((hi - lo) as f32 * self.cascade.cell_m[axis])
-            } else {
-                0.0
-            };
-            current[axis] =
-                -field.diffusion_m[i] * gradient + self.beam_current(field, i, axis).dot(LUMINANCE);
-        }
-        (current / lum(c).max(1e-12)).clamp_length_max(MAX_RELATIVE_CURRENT)
+        let (gradient, _) = self.luminance_gradient(field, c);
+        let beam = Vec3::from_array(
+            [0, 1, 2].map(|axis| self.beam_current(field, i, axis).dot(LUMINANCE)),
+        );
+        let current = -field.diffusion_m[i] * gradient + beam;
+        let luminance = field.radiance[i].dot(LUMINANCE);
+        (current / luminance.max(1e-12)).clamp_length_max(MAX_RELATIVE_CURRENT)
     }
 
     /// Diffuse power leaving the grid through its top and its bottom, `4 pi J . n` summed over
