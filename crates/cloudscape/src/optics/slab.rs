@@ -1,5 +1,8 @@
-//! The sun's light inside a cloud by the δ-Eddington solution of a slab along the sun: the
-//! physically founded multiple-scattering model of the ray marcher (`lighting.model = "slab"`).
+//! The sun's light inside a cloud by the δ-Eddington solution of a slab along the sun: the ray
+//! marcher's former multiple-scattering model (`lighting.model = "slab"`), which the light volume
+//! (`environment::light_volume`, the same equations solved in 3-D) replaced; its closed form is what
+//! the volume's infinite-slab test holds the volume to, and its beam part
+//! ([`SunSlab::beam_scattering`]) is what the march adds per sample beside the volume.
 //!
 //! At a point the march knows the optical depth toward the sun (`tau_sun`, its light samples) and
 //! away from it (`tau_back`, to the far side of the layers). The model takes the cloud there as a
