@@ -310,7 +310,8 @@ fn make_texture(ctx: &GpuContext, shape: &TableShape, stand_in: bool) -> wgpu::T
         format: TABLE_FORMAT,
         usage: wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::STORAGE_BINDING
-            | wgpu::TextureUsages::COPY_SRC,
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     })
 }
@@ -427,6 +428,13 @@ impl EnvironmentGpu {
                 .collect(),
             _ => vec![texture.create_view(&Default::default())],
         }
+    }
+
+    /// The light volume's table, which its pass fills by a copy: GL binds a 3-D storage texture
+    /// one slice at a time (wgpu's GL backend binds a single-layer view unlayered), so a compute
+    /// pass cannot write all of it.
+    pub fn light_volume_texture(&self) -> &wgpu::Texture {
+        &self.textures[EnvironmentTable::LightVolume.bindings()[0] - 1]
     }
 
     /// The storage views of `table` ([`EnvironmentTable`]'s outputs, in binding order).

@@ -11,8 +11,10 @@
 @group(3) @binding(1) var<storage, read_write> volume_radiance: array<vec4<f32>>;
 // Per cell: the flux-limited diffusion coefficient, metres.
 @group(3) @binding(2) var<storage, read_write> volume_diffusion: array<f32>;
-// The environment's table: I0 of each cascade side by side along z, then J / I0 the same way.
-@group(3) @binding(3) var volume_table_out: texture_storage_3d<rgba16float, write>;
+// The environment's table as rgba16float texels (two packed u32 each), rows padded to
+// LIGHT_VOLUME_ROW_TEXELS for the copy into the 3-D texture: I0 of each cascade side by side along
+// z, then J / I0 the same way.
+@group(3) @binding(3) var<storage, read_write> volume_table_out: array<vec2<u32>>;
 
 const LIGHT_VOLUME_LUMINANCE = vec3<f32>(0.2126, 0.7152, 0.0722);
 
@@ -287,6 +289,28 @@ fn light_volume_relax_black_uncoupled(@builtin(global_invocation_id) id: vec3<u3
     light_volume_relax(id.xy, 1u, false);
 }
 
+// Writes texel t of the table as rgba16float (two halves to a u32, the first in the low bits).
+fn light_volume_store(t: vec3<u32>, value: vec4<f32>) {
+    let n = light_volume_cells_of();
+    let row_texels = (n.x + LIGHT_VOLUME_ROW_TEXELS - 1u) / LIGHT_VOLUME_ROW_TEXELS * LIGHT_VOLUME_ROW_TEXELS;
+    let packed = vec2<u32>(light_volume_half(value.x) | (light_volume_half(value.y) << 16u), light_volume_half(value.z) | (light_volume_half(value.w) << 16u));
+    volume_table_out[(t.z * n.y + t.y) * row_texels + t.x] = packed;
+}
+
+// The IEEE half-precision bits of x, rounded to nearest, below the smallest normal half (6.1e-5)
+// flushed to zero and above the largest (65504) clamped to it (WGSL's pack2x16float needs a
+// capability not every adapter offers).
+fn light_volume_half(x: f32) -> u32 {
+    let bits = bitcast<u32>(x);
+    let sign = (bits >> 16u) & 0x8000u;
+    let exponent = i32((bits >> 23u) & 0xffu) - 112;
+    if exponent <= 0 {
+        return sign;
+    }
+    let half = (u32(exponent) << 10u) + (((bits & 0x7fffffu) + 0x1000u) >> 13u);
+    return sign | min(half, 0x7bffu);
+}
+
 // A cell's weight in the table's interpolation (read::interpolation_weight).
 fn light_volume_weight(extinction: f32, h: vec3<f32>) -> f32 {
     return clamp(extinction * min(h.x, min(h.y, h.z)), LIGHT_VOLUME_MIN_WEIGHT, 1.0);
@@ -315,7 +339,7 @@ fn light_volume_export(@builtin(global_invocation_id) id: vec3<u32>) {
     var relative = current / max(dot(radiance, LIGHT_VOLUME_LUMINANCE), 1e-12);
     relative *= min(1.0, LIGHT_VOLUME_MAX_RELATIVE_CURRENT / max(length(relative), 1e-20));
     let weight = light_volume_weight(volume_cells[i].w, h);
-    let texel = vec3<u32>(c.x, c.y, c.z + v.cells.z * k);
-    textureStore(volume_table_out, texel, vec4<f32>(radiance, 1.0) * weight);
-    textureStore(volume_table_out, texel + vec3<u32>(0u, 0u, v.cells.z * v.cascades), vec4<f32>(relative, 1.0) * weight);
+    let slice = c.z + v.cells.z * k;
+    light_volume_store(vec3<u32>(c.x, c.y, slice), vec4<f32>(radiance, 1.0) * weight);
+    light_volume_store(vec3<u32>(c.x, c.y, slice + v.cells.z * v.cascades), vec4<f32>(relative, 1.0) * weight);
 }

@@ -27,11 +27,16 @@ const ENTRIES: [&str; 7] = [
     "light_volume_export",
 ];
 
-/// The solve's buffers (cells' inputs, radiance, diffusion coefficients) and pipelines, with the
-/// grid whose solution the radiance holds.
+/// Texels a row of the table's staging buffer is padded to: wgpu copies rows of 256 bytes
+/// (`COPY_BYTES_PER_ROW_ALIGNMENT`), 32 rgba16float texels.
+const ROW_TEXELS: u32 = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT / 8;
+
+/// The solve's buffers (cells' inputs, radiance, diffusion coefficients, the table staged for its
+/// copy into the environment's texture) and pipelines, with the grid whose solution the radiance
+/// holds.
 pub struct LightVolumePass {
     pass: ComputePass,
-    buffers: Option<[wgpu::Buffer; 3]>,
+    buffers: Option<[wgpu::Buffer; 4]>,
     group: BindGroupCache,
     solved: Option<LightVolumeGrid>,
 }
@@ -47,9 +52,13 @@ impl LightVolumePass {
         }
     }
 
-    /// Makes the buffers hold `cells` cells; true when they were remade (and hold nothing).
-    fn ensure_buffers(&mut self, ctx: &GpuContext, cells: u64) -> bool {
-        let bytes = [16 * cells, 16 * cells, 4 * cells];
+    /// Makes the buffers hold the cells of `grid`; true when they were remade (and hold nothing).
+    fn ensure_buffers(&mut self, ctx: &GpuContext, grid: &LightVolumeGrid) -> bool {
+        let cascades = grid.cascades.len() as u64;
+        let cells = u64::from(grid.cells.element_product()) * cascades;
+        let n = grid.cells;
+        let table = 8 * u64::from(table_row_texels(n.x) * n.y * 2 * n.z) * cascades;
+        let bytes = [16 * cells, 16 * cells, 4 * cells, table];
         if self
             .buffers
             .as_ref()
@@ -61,8 +70,9 @@ impl LightVolumePass {
             "light volume cells",
             "light volume radiance",
             "light volume diffusion",
+            "light volume table",
         ];
-        self.buffers = Some([0, 1, 2].map(|i| storage_buffer(ctx, labels[i], bytes[i])));
+        self.buffers = Some([0, 1, 2, 3].map(|i| storage_buffer(ctx, labels[i], bytes[i])));
         self.group.clear();
         true
     }
@@ -83,26 +93,21 @@ impl LightVolumePass {
             "the light volume's columns hold at most {MAX_COLUMN_CELLS} cells"
         );
         let cascades = grid.cascades.len() as u32;
-        let cells = u64::from(grid.cells.element_product() * cascades);
-        let remade = self.ensure_buffers(ctx, cells);
+        let remade = self.ensure_buffers(ctx, grid);
         let cold = remade || !may_start_warm || self.solved.as_ref() != Some(grid);
         let buffers = self.buffers.as_ref().expect("made above");
         if cold {
             encoder.clear_buffer(&buffers[1], 0, None);
         }
-        let views = environment.output_views(EnvironmentTable::LightVolume);
         let pass = &self.pass;
-        let group = self.group.get(&views.iter().collect::<Vec<_>>(), || {
+        let group = self.group.get(&[], || {
             pass.group.bind(
                 ctx,
                 &[
                     ("volume_cells", buffers[0].as_entire_binding()),
                     ("volume_radiance", buffers[1].as_entire_binding()),
                     ("volume_diffusion", buffers[2].as_entire_binding()),
-                    (
-                        "volume_table_out",
-                        wgpu::BindingResource::TextureView(&views[0]),
-                    ),
+                    ("volume_table_out", buffers[3].as_entire_binding()),
                 ],
             )
         });
@@ -146,8 +151,46 @@ impl LightVolumePass {
         record(cells_name, &[(ENTRIES[0], over_cells)]);
         record(solve_name, &steps);
         record(table_name, &[(ENTRIES[6], over_cells)]);
+        copy_table(
+            encoder,
+            &buffers[3],
+            environment.light_volume_texture(),
+            grid,
+        );
         self.solved = Some(grid.clone());
     }
+}
+
+/// Texels of a row of the staged table for `width` cells: padded to [`ROW_TEXELS`].
+fn table_row_texels(width: u32) -> u32 {
+    width.div_ceil(ROW_TEXELS) * ROW_TEXELS
+}
+
+/// Copies the staged table into the environment's texture (radiance, then current, along z).
+fn copy_table(
+    encoder: &mut wgpu::CommandEncoder,
+    staged: &wgpu::Buffer,
+    texture: &wgpu::Texture,
+    grid: &LightVolumeGrid,
+) {
+    let n = grid.cells;
+    let slices = 2 * n.z * grid.cascades.len() as u32;
+    encoder.copy_buffer_to_texture(
+        wgpu::TexelCopyBufferInfo {
+            buffer: staged,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(8 * table_row_texels(n.x)),
+                rows_per_image: Some(n.y),
+            },
+        },
+        texture.as_image_copy(),
+        wgpu::Extent3d {
+            width: n.x,
+            height: n.y,
+            depth_or_array_layers: slices,
+        },
+    );
 }
 
 /// The light volume's solve on the GPU (`light_volume.wgsl`).
@@ -172,6 +215,7 @@ fn light_volume_constants() -> String {
         ("LIGHT_VOLUME_BEAM_PATH_MAX_M", F32(BEAM_PATH_MAX_M)),
         ("LIGHT_VOLUME_BEAM_MIN_SUN_Y", F32(BEAM_MIN_SUN_Y)),
         ("LIGHT_VOLUME_MAX_COLUMN_CELLS", U32(MAX_COLUMN_CELLS)),
+        ("LIGHT_VOLUME_ROW_TEXELS", U32(ROW_TEXELS)),
         (
             "LIGHT_VOLUME_MAX_RELATIVE_CURRENT",
             F32(super::solve::MAX_RELATIVE_CURRENT),
