@@ -884,15 +884,51 @@ fn the_light_volume_matches_the_cpu() {
         .iter()
         .map(|i| volume.diffuse(i.a.truncate(), i.b.truncate()))
         .collect();
-    let scale = want.iter().map(|w| w.max_element()).fold(0.0, f32::max);
-    assert!(scale > 0.0, "the volume holds light");
-    for (i, (g, w)) in got.iter().zip(&want).enumerate() {
-        let error = (g.truncate() - *w).abs().max_element() / scale;
-        assert!(error <= 0.03, "#{i} at {}: GPU {g} vs CPU {w}", inputs[i].a);
-    }
+    assert_within_scale("diffuse light", &inputs, &got, &want, 0.03);
     let lit = want
         .iter()
-        .filter(|w| w.max_element() > 0.1 * scale)
+        .filter(|w| w.max_element() > 0.1 * max_element(&want))
         .count();
     assert!(lit > 40, "most points see diffuse light ({lit})");
+    // The ground's diffuse light below the same points.
+    let ground: Vec<ProbeInput> = inputs
+        .iter()
+        .map(|i| input(i.a.with_y(0.0), Vec4::ZERO))
+        .collect();
+    let got = gpu(
+        &ctx,
+        &clouds,
+        ProbeFunction::LightVolumeGroundIrradiance,
+        &ground,
+    );
+    let want: Vec<Vec3> = ground
+        .iter()
+        .map(|i| volume.ground_irradiance(i.a.truncate()).expect("a volume"))
+        .collect();
+    assert_within_scale("ground irradiance", &ground, &got, &want, 0.03);
+}
+
+/// The largest channel of any of `values`.
+fn max_element(values: &[Vec3]) -> f32 {
+    values.iter().map(|w| w.max_element()).fold(0.0, f32::max)
+}
+
+/// Asserts each GPU value within `tolerance` of the largest CPU value of its CPU twin.
+fn assert_within_scale(
+    what: &str,
+    inputs: &[ProbeInput],
+    got: &[Vec4],
+    want: &[Vec3],
+    tolerance: f32,
+) {
+    let scale = max_element(want);
+    assert!(scale > 0.0, "the volume holds {what}");
+    for (i, (g, w)) in got.iter().zip(want).enumerate() {
+        let error = (g.truncate() - *w).abs().max_element() / scale;
+        assert!(
+            error <= tolerance,
+            "{what} #{i} at {}: GPU {g} vs CPU {w}",
+            inputs[i].a
+        );
+    }
 }

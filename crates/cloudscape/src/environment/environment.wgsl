@@ -308,18 +308,42 @@ fn environment_light_volume_uvw(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(local.x / n.x, local.y / n.y, (local.z + n.z * f32(k)) / (2.0 * n.z * f32(v.cascades)));
 }
 
-// The diffuse light of the clouds at world point p scattered toward the eye along `toward_eye`
-// (unit), per unit scattering coefficient: I0 + g w . I1 of the light volume's δ-Eddington
-// solution, with I1 = 3 J (optics/slab.rs scatters its slab's diffuse field the same way),
-// interpolated with the cells' weights (their optical thickness: a point in a cloud's edge reads
-// the cloud's cells more than the clear air beside them). Zero without a volume.
-fn environment_light_volume_diffuse(p: vec3<f32>, toward_eye: vec3<f32>) -> vec3<f32> {
+// The light volume's I0 (rgb) and its current over it (LightVolume::sample) at world point p,
+// clamped into the finest cascade holding it, interpolated with the cells' weights (their optical
+// thickness: a point in a cloud's edge reads the cloud's cells more than the clear air beside them).
+struct LightVolumeSample {
+    radiance: vec3<f32>,
+    current: vec3<f32>,
+}
+
+fn environment_light_volume_sample(p: vec3<f32>) -> LightVolumeSample {
     let uvw = environment_light_volume_uvw(p);
     let weighted = textureSampleLevel(environment_light_volume, environment_linear, uvw, 0.0);
     let weighted_current = textureSampleLevel(environment_light_volume, environment_linear, uvw + vec3<f32>(0.0, 0.0, 0.5), 0.0);
-    let radiance = weighted.rgb / max(weighted.a, 1e-6);
-    let current = weighted_current.xyz / max(weighted_current.a, 1e-6);
+    return LightVolumeSample(weighted.rgb / max(weighted.a, 1e-6), weighted_current.xyz / max(weighted_current.a, 1e-6));
+}
+
+// Whether the frame has a light volume (a technique reads it and there are clouds).
+fn environment_has_light_volume() -> bool {
+    return environment.light_volume.enabled == 1u;
+}
+
+// The diffuse light of the clouds at world point p scattered toward the eye along `toward_eye`
+// (unit), per unit scattering coefficient: I0 + g w . I1 of the light volume's δ-Eddington
+// solution, with I1 = 3 J (optics/slab.rs scatters its slab's diffuse field the same way)
+// (LightVolume::diffuse). Zero without a volume.
+fn environment_light_volume_diffuse(p: vec3<f32>, toward_eye: vec3<f32>) -> vec3<f32> {
+    let s = environment_light_volume_sample(p);
     let g = environment.light_volume.optics.w;
-    let diffuse = radiance * max(1.0 + 3.0 * g * dot(current, toward_eye), 0.0);
-    return select(vec3<f32>(0.0), diffuse, environment.light_volume.enabled == 1u);
+    let diffuse = s.radiance * max(1.0 + 3.0 * g * dot(s.current, toward_eye), 0.0);
+    return select(vec3<f32>(0.0), diffuse, environment_has_light_volume());
+}
+
+// The diffuse irradiance on level ground at g from the sky and the clouds above it, the downward
+// hemisphere of the volume's bottom cells, pi I0 - 2 pi J_y (LightVolume::ground_irradiance).
+// Zero without a volume.
+fn environment_light_volume_ground_irradiance(g: vec3<f32>) -> vec3<f32> {
+    let s = environment_light_volume_sample(g);
+    let irradiance = PI * s.radiance * max(1.0 - 2.0 * s.current.y, 0.0);
+    return select(vec3<f32>(0.0), irradiance, environment_has_light_volume());
 }

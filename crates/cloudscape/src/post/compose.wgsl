@@ -9,21 +9,27 @@
 @group(3) @binding(3) var compose_host_depth: texture_2d<f32>;
 @group(3) @binding(4) var compose_out: texture_storage_2d<rgba16float, write>;
 
-// Radiance leaving the Lambertian ground at g: the sun's and the sky's share of ground_radiance,
-// each dimmed by the clouds' diffuse transmittance between the ground and the light, read from the
-// shared shadow map (the sun's along its slant path: the direct beam and the light the clouds
-// scatter forward, most of it within a few degrees of the sun), as the path tracer's ground sees
-// them through the same field: environment_ground_radiance, shadowed.
+// Radiance leaving the Lambertian ground at g. With a light volume, the δ-Eddington split the
+// clouds are lit by: the scaled sun beam through the clouds (the direct sun and the light they
+// scatter forward, exp(-tau') along its slant path in the shared shadow map) and the volume's
+// diffuse light from the sky and the clouds' bases (environment_light_volume_ground_irradiance).
+// Without one, the sun's and the sky's share of environment_ground_radiance, each dimmed by the
+// clouds' diffuse transmittance between the ground and the light, read from the shadow map.
 fn compose_ground(g: vec3<f32>) -> vec3<f32> {
     let sun = environment_sun_direction();
-    let sun_part = frame.ground_albedo / PI * environment_sun_irradiance(g) * max(sun.y, 0.0);
-    let sky_part = frame.ground_albedo / PI * environment_sky_irradiance_up(g);
-    var sun_t = 0.0;
+    let sun_irradiance = environment_sun_irradiance(g) * max(sun.y, 0.0);
+    var tau_sun = 0.0;
     if sun.y > 0.0 {
-        sun_t = frame_diffuse_transmittance(environment_cloud_sun_optical_depth(g));
+        tau_sun = environment_cloud_sun_optical_depth(g);
     }
+    if environment_has_light_volume() {
+        let beam = sun_irradiance * exp(-environment.light_volume.optics.z * tau_sun);
+        return frame.ground_albedo / PI * (beam + environment_light_volume_ground_irradiance(g));
+    }
+    let sun_t = select(0.0, frame_diffuse_transmittance(tau_sun), sun.y > 0.0);
     let sky_t = frame_diffuse_transmittance(environment_cloud_sky_optical_depth(g));
-    return sun_part * sun_t + sky_part * sky_t;
+    let sky = environment_sky_irradiance_up(g);
+    return frame.ground_albedo / PI * (sun_irradiance * sun_t + sky * sky_t);
 }
 
 // What lies behind the clouds along the ray through pixel `px`, as the eye sees it through the haze.

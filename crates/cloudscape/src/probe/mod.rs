@@ -80,6 +80,8 @@ pub enum ProbeFunction {
     /// `environment_light_volume_diffuse(a.xyz, toward the eye b.xyz)`:
     /// `LightVolume::diffuse`.
     LightVolumeDiffuse = 28,
+    /// `environment_light_volume_ground_irradiance(a.xyz)`: `LightVolume::ground_irradiance`.
+    LightVolumeGroundIrradiance = 29,
 }
 
 /// The inputs of one evaluation.

@@ -56,7 +56,6 @@ pub fn diffusion(
         })
         .collect();
     let environment = light.environment;
-    let centre_top = cascade.centre(UVec3::new(cells.x / 2, cells.y - 1, cells.z / 2));
     Diffusion {
         cascade,
         cells,
@@ -68,7 +67,7 @@ pub fn diffusion(
         },
         beam_direction: -sun,
         boundaries: Boundaries {
-            sky_down: environment.sky_irradiance_up(centre_top) / PI,
+            sky_down: environment.sky_irradiance_up(environment.viewpoint_m) / PI,
             ground_albedo: light.ground_albedo,
             sky_up: environment.sky_radiance(Vec3::NEG_Y),
         },

@@ -143,15 +143,15 @@ fn light_volume_beam_current(i: u32, axis: u32) -> vec3<f32> {
 }
 
 // The radiance entering the top (step 1) or bottom (-1) face of cell i as alpha I0 + beta
-// (Diffusion::entering); `top` the point the sky is looked up at.
+// (Diffusion::entering): the sky from above as the viewpoint sees it (the path tracer's sky).
 struct LightVolumeEntering {
     alpha: vec3<f32>,
     beta: vec3<f32>,
 }
 
-fn light_volume_entering(i: u32, step: i32, top: vec3<f32>) -> LightVolumeEntering {
+fn light_volume_entering(i: u32, step: i32) -> LightVolumeEntering {
     if step > 0 {
-        return LightVolumeEntering(vec3<f32>(0.0), environment_sky_irradiance_up(top) / PI);
+        return LightVolumeEntering(vec3<f32>(0.0), environment_sky_irradiance_up(environment.viewpoint_m) / PI);
     }
     if frame.has_ground == 0u {
         return LightVolumeEntering(vec3<f32>(0.0), environment_sky_radiance(vec3<f32>(0.0, -1.0, 0.0)));
@@ -164,9 +164,9 @@ fn light_volume_entering(i: u32, step: i32, top: vec3<f32>) -> LightVolumeEnteri
 
 // Outward current through the top or bottom face of cell i as coefficient I0 + constant
 // (Diffusion::face_current).
-fn light_volume_face_current(i: u32, step: i32, h_y: f32, top: vec3<f32>) -> array<vec3<f32>, 2> {
+fn light_volume_face_current(i: u32, step: i32, h_y: f32) -> array<vec3<f32>, 2> {
     let conductance = 2.0 * volume_diffusion[i] / h_y;
-    let entering = light_volume_entering(i, step, top);
+    let entering = light_volume_entering(i, step);
     let outward_beam = f32(step) * light_volume_beam_current(i, 1u);
     let scale = 1.0 / (1.0 + 2.0 * conductance);
     return array<vec3<f32>, 2>(conductance * (1.0 - entering.alpha) * scale, (outward_beam - conductance * entering.beta) * scale);
@@ -182,7 +182,6 @@ fn light_volume_relax_column(x: u32, z: u32, k: u32, coupled: bool) {
     let v = environment.light_volume;
     let n = v.cells;
     let h = v.cascade_cell_m[k].xyz;
-    let top = light_volume_centre(vec3<u32>(n.x / 2u, n.y - 1u, n.z / 2u), k);
     var c_prime: array<vec3<f32>, LIGHT_VOLUME_MAX_COLUMN_CELLS>;
     var d_prime: array<vec3<f32>, LIGHT_VOLUME_MAX_COLUMN_CELLS>;
     var previous_c = vec3<f32>(0.0);
@@ -221,7 +220,7 @@ fn light_volume_relax_column(x: u32, z: u32, k: u32, coupled: bool) {
             let neighbour = i32(y) + step;
             let b_here = light_volume_beam_current(i, 1u);
             if neighbour < 0 || neighbour >= i32(n.y) {
-                let face = light_volume_face_current(i, step, h.y, top);
+                let face = light_volume_face_current(i, step, h.y);
                 diag += face[0] / h.y;
                 rhs -= face[1] / h.y;
                 continue;

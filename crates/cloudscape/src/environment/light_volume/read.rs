@@ -6,6 +6,7 @@ use super::solve::{DiffuseField, Diffusion};
 use super::{DiffuseOptics, LightVolumeGrid, LightVolumeSettings};
 use crate::field::CloudField;
 use glam::{UVec3, Vec3};
+use std::f32::consts::PI;
 
 /// Least weight of a cell in the table's interpolation: clear air among clear air still
 /// interpolates.
@@ -55,8 +56,28 @@ impl LightVolume {
     /// scattering coefficient: `I0 (1 + 3 g J / I0 . w)` interpolated trilinearly in the finest
     /// cascade holding `p` (`environment_light_volume_diffuse`).
     pub fn diffuse(&self, p: Vec3, toward_eye: Vec3) -> Vec3 {
-        if !self.enabled {
+        let Some((radiance, current, g)) = self.sample(p) else {
             return Vec3::ZERO;
+        };
+        radiance * (1.0 + 3.0 * g * current.dot(toward_eye)).max(0.0)
+    }
+
+    /// The diffuse irradiance on level ground at `g` from the sky and the clouds above it (the
+    /// light of the grid's bottom face there): the downward hemisphere of the P1 radiance
+    /// `I0 + 3 J . w`, `E = pi I0 - 2 pi J_y` (`environment_light_volume_ground_irradiance`).
+    /// Under a clear sky it is the sky's irradiance; under a deck, what the deck passes on and
+    /// sends back of the ground's own light. None without a volume.
+    pub fn ground_irradiance(&self, g: Vec3) -> Option<Vec3> {
+        let (radiance, current, _) = self.sample(g)?;
+        Some(PI * radiance * (1.0 - 2.0 * current.y).max(0.0))
+    }
+
+    /// `I0`, the current over it and the droplets' mean cosine at `p` (clamped into the finest
+    /// cascade holding it, so that points below the grid read its bottom cells), each cell
+    /// weighted by its optical thickness; None without a volume.
+    fn sample(&self, p: Vec3) -> Option<(Vec3, Vec3, f32)> {
+        if !self.enabled {
+            return None;
         }
         let (problem, solution) = self.cascade_at(p);
         let n = problem.cells.as_vec3();
@@ -77,9 +98,8 @@ impl LightVolume {
             current += w * problem.relative_current(solution, c);
             weights += w;
         }
-        let (radiance, current) = (radiance / weights, current / weights);
         let g = problem.optics.mean_cosine;
-        radiance * (1.0 + 3.0 * g * current.dot(toward_eye)).max(0.0)
+        Some((radiance / weights, current / weights, g))
     }
 
     /// The finest cascade holding `p` within half a cell of its sides, else the coarsest.

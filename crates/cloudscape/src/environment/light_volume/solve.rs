@@ -48,7 +48,8 @@ pub const LUMINANCE: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
 /// What enters one cascade's grid at its top and bottom faces.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Boundaries {
-    /// Cosine-weighted mean radiance of the sky entering the top face.
+    /// Cosine-weighted mean radiance of the sky entering the top face: the sky the viewpoint
+    /// sees (the path tracer lights every point with the camera's sky).
     pub sky_down: Vec3,
     /// Below the bottom face: a Lambertian ground of this albedo, or (None) the sky's radiance
     /// `sky_up` from below.

@@ -175,3 +175,48 @@ fn light_diffuses_sideways_out_of_a_lit_column() {
     );
     assert!(glow(20) > 0.0);
 }
+
+/// The ground's diffuse irradiance at `(x, z)` under `problem` lit by an isotropic sky of unit
+/// radiance alone.
+fn ground_under_sky(mut problem: Diffusion, (x, z): (f32, f32)) -> f32 {
+    use super::read::LightVolume;
+    for cell in problem.inputs.iter_mut() {
+        cell[0] = 0.0;
+        cell[1] = 0.0;
+        cell[2] = 0.0;
+    }
+    problem.boundaries.sky_down = Vec3::ONE;
+    let mut field = problem.cold_field();
+    problem.solve(&mut field, 200, true);
+    let volume = LightVolume {
+        cascades: vec![(problem, field)],
+        enabled: true,
+    };
+    volume
+        .ground_irradiance(Vec3::new(x, -500.0, z))
+        .expect("a volume")
+        .x
+}
+
+#[test]
+fn the_ground_sees_the_sky_in_clear_air_and_less_under_a_cloud() {
+    let (cloud, _) = blob();
+    let mut clear = cloud.clone();
+    for cell in clear.inputs.iter_mut() {
+        cell[3] = 0.0;
+    }
+    // A clear column passes the sky's irradiance `pi L` on as free streaming does, less what the
+    // cap on the diffusion coefficient (one grid height) holds back: the column's resistance
+    // `H / D = 1` beside Marshak's 4 at its two faces, a fifth.
+    let sky = std::f32::consts::PI;
+    let open = ground_under_sky(clear, (600.0, 600.0));
+    assert!(
+        (open / (0.8 * sky) - 1.0).abs() < 0.02,
+        "clear air {open}, the sky gives {sky}"
+    );
+    let shaded = ground_under_sky(cloud, (600.0, 600.0));
+    assert!(
+        shaded < 0.8 * open,
+        "under the cloud {shaded}, in clear air {open}"
+    );
+}
