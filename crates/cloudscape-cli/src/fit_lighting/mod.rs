@@ -6,6 +6,7 @@
 //! model's diffuse and far-side factors, the octaves' `(a, b, c)`. Held-out scenes score the fits.
 
 mod fit;
+mod ground;
 mod samples;
 
 use crate::common::progress_bar;
@@ -84,6 +85,7 @@ pub fn run(args: FitLightingArgs) -> Result<()> {
         &training,
         &validation,
     );
+    print_ground(&args)?;
     println!(
         "\n[lighting]\nslab_diffuse_scale = {:.3}\nslab_back_scale = {:.3}\noctave_attenuation = {:.3}\noctave_contribution = {:.3}\noctave_eccentricity = {:.3}",
         fitted_slab.diffuse_scale,
@@ -139,6 +141,59 @@ fn print_classes(
         all[2].mean_ratio,
         all[2].relative_rms
     );
+}
+
+/// Ground points per scene: a fifth of the camera rays.
+const GROUND_POINTS_DIVISOR: u32 = 5;
+
+/// The class "ground under cloud": every scene's ground points under cloud (optical depth of at
+/// least [`ground::MIN_OPTICAL_DEPTH_ABOVE`] straight up) inside the light volume's finest
+/// cascade, each model's mean light leaving the ground over the path tracer's.
+fn print_ground(args: &FitLightingArgs) -> Result<()> {
+    let scenes =
+        (0..args.scenes).chain(FIRST_VALIDATION_SCENE..FIRST_VALIDATION_SCENE + args.validation);
+    let bar = progress_bar("ground");
+    bar.set_length(u64::from(args.scenes + args.validation));
+    let (mut traced, mut volume, mut shadow_map, mut n) = (0.0f64, 0.0f64, 0.0f64, 0);
+    for index in scenes {
+        let points = args.points / GROUND_POINTS_DIVISOR;
+        let path = args.data.join(format!(
+            "ground-{index}-{points}x{}-r{}.csv",
+            args.paths,
+            cloudscape_reference::TRACER_REVISION
+        ));
+        let samples = match ground::read(&path) {
+            Some(samples) => samples,
+            None => {
+                let reach = Scene::default().lighting.volume_extent_m;
+                let samples = ground::ground_samples(index, (points, args.paths), reach)?;
+                ground::write(&path, &samples)?;
+                samples
+            }
+        };
+        for (s, p) in samples.iter().zip(ground::predict(index, &samples)?) {
+            traced += f64::from(s.radiance);
+            volume += f64::from(p.volume);
+            shadow_map += f64::from(p.shadow_map);
+            n += 1;
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    println!(
+        "\nGround under cloud, the {n} ground points of all scenes under an optical depth of at \
+         least {} inside the finest cascade: mean light leaving the ground over the path tracer's\n",
+        ground::MIN_OPTICAL_DEPTH_ABOVE
+    );
+    println!("| class | points | light volume | shadow map's diffuse transmittance |");
+    println!("|---|---|---|---|");
+    let t = traced.max(1e-12);
+    println!(
+        "| ground under cloud | {n} | {:.3} | {:.3} |",
+        volume / t,
+        shadow_map / t
+    );
+    Ok(())
 }
 
 fn print_row(name: &str, model: &Model, training: Score, held_out: Score) {
@@ -225,7 +280,7 @@ fn read(path: &Path, index: u32) -> Result<Option<Vec<Sample>>> {
     if lines.next() != Some(HEADER) {
         return Ok(None);
     }
-    let (_, family) = samples::training_scene(index)?;
+    let (_, family) = samples::training_scene(index, false)?;
     Ok(lines
         .map(|line| {
             let v: Vec<f32> = line

@@ -79,9 +79,9 @@ impl Family {
 }
 
 /// The generated training scene `index` and its cloud family: a cloud layer and a sun drawn from
-/// `index`, lit by the sun alone (no sky, no ground, no haze), so the light found at a point is
-/// the sun's.
-pub fn training_scene(index: u32) -> Result<(SceneDocument, Family)> {
+/// `index`, lit by the sun alone (no sky, no haze, and a ground of the default albedo only when
+/// `ground`), so the light found at a point is the sun's.
+pub fn training_scene(index: u32, ground: bool) -> Result<(SceneDocument, Family)> {
     let mut rng = Rng::for_sample(0x5eed, u64::from(index), 0);
     let mut draw = |lo: f32, hi: f32| lo + (hi - lo) * rng.next_f32();
     let elevation = draw(3.0, 87.0);
@@ -106,7 +106,7 @@ pub fn training_scene(index: u32) -> Result<(SceneDocument, Family)> {
         "sky.model=\"constant\"".into(),
         "sky.radiance=[0.0, 0.0, 0.0]".into(),
         "sky.visibility_m=10000000.0".into(),
-        "ground.enabled=false".into(),
+        format!("ground.enabled={ground}"),
         format!("layers.0.coverage={coverage}"),
         format!("layers.0.extinction_per_m={extinction}"),
         format!("layers.0.thickness_m={thickness}"),
@@ -120,7 +120,7 @@ pub fn training_scene(index: u32) -> Result<(SceneDocument, Family)> {
 
 /// `points` camera rays into training scene `index`, each collision estimated with `paths` paths.
 pub fn scene_samples(index: u32, points: u32, paths: u32) -> Result<Vec<Sample>> {
-    let (doc, family) = training_scene(index)?;
+    let (doc, family) = training_scene(index, false)?;
     let tracer = PathTracer::for_scene(
         &doc.scene,
         &doc.resolve_path(""),
@@ -185,7 +185,7 @@ pub fn fill_volume(index: u32, samples: &mut [Sample]) -> Result<()> {
         DiffuseOptics, LightVolume, LightVolumeGrid, LightVolumeSettings,
     };
     use cloudscape::environment::{Environment, ViewedEnvironment};
-    let (doc, _) = training_scene(index)?;
+    let (doc, _) = training_scene(index, false)?;
     let scene = &doc.scene;
     let field = cloudscape::field::CloudField::new(scene, &doc.resolve_path(""))
         .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
