@@ -292,8 +292,8 @@ fn environment_cloud_sun_transmittance(p: vec3<f32>) -> f32 {
     return exp(-environment_cloud_sun_optical_depth(p));
 }
 
-// Texture coordinates of world point p in the light volume's radiance (its current lies half the
-// texture further along z): the finest cascade holding p (within half a cell of its sides), else
+// Texture coordinates of world point p in the light volume's radiance (its current lies a third of
+// the texture further along z, the ground's irradiance two thirds): the finest cascade holding p (within half a cell of its sides), else
 // the coarsest, clamped to its cells' centres so that no neighbouring cascade bleeds in.
 fn environment_light_volume_uvw(p: vec3<f32>) -> vec3<f32> {
     let v = environment.light_volume;
@@ -305,7 +305,7 @@ fn environment_light_volume_uvw(p: vec3<f32>) -> vec3<f32> {
         k = select(k, c - 1u, inside);
     }
     let local = clamp((p - v.cascade_min_m[k].xyz) / v.cascade_cell_m[k].xyz, vec3<f32>(0.5), n - 0.5);
-    return vec3<f32>(local.x / n.x, local.y / n.y, (local.z + n.z * f32(k)) / (2.0 * n.z * f32(v.cascades)));
+    return vec3<f32>(local.x / n.x, local.y / n.y, (local.z + n.z * f32(k)) / (f32(LIGHT_VOLUME_TABLE_PARTS) * n.z * f32(v.cascades)));
 }
 
 // The light volume's I0 (rgb) and its current over it (LightVolume::sample) at world point p,
@@ -319,7 +319,7 @@ struct LightVolumeSample {
 fn environment_light_volume_sample(p: vec3<f32>) -> LightVolumeSample {
     let uvw = environment_light_volume_uvw(p);
     let weighted = textureSampleLevel(environment_light_volume, environment_linear, uvw, 0.0);
-    let weighted_current = textureSampleLevel(environment_light_volume, environment_linear, uvw + vec3<f32>(0.0, 0.0, 0.5), 0.0);
+    let weighted_current = textureSampleLevel(environment_light_volume, environment_linear, uvw + vec3<f32>(0.0, 0.0, 1.0 / f32(LIGHT_VOLUME_TABLE_PARTS)), 0.0);
     return LightVolumeSample(weighted.rgb / max(weighted.a, 1e-6), weighted_current.xyz / max(weighted_current.a, 1e-6));
 }
 
@@ -339,11 +339,13 @@ fn environment_light_volume_diffuse(p: vec3<f32>, toward_eye: vec3<f32>) -> vec3
     return select(vec3<f32>(0.0), diffuse, environment_has_light_volume());
 }
 
-// The diffuse irradiance on level ground at g from the sky and the clouds above it, the downward
-// hemisphere of the volume's bottom cells, pi I0 - 2 pi J_y (LightVolume::ground_irradiance).
-// Zero without a volume.
+// The diffuse irradiance on level ground at g from the sky and the clouds above it: what leaves the
+// volume's bottom face there, the table's third part, bilinear between columns
+// (LightVolume::ground_irradiance). Zero without a volume.
 fn environment_light_volume_ground_irradiance(g: vec3<f32>) -> vec3<f32> {
-    let s = environment_light_volume_sample(g);
-    let irradiance = PI * s.radiance * max(1.0 - 2.0 * s.current.y, 0.0);
+    let bottom = environment_light_volume_uvw(vec3<f32>(g.x, -1e9, g.z));
+    let third = 2.0 / f32(LIGHT_VOLUME_TABLE_PARTS);
+    let texel = textureSampleLevel(environment_light_volume, environment_linear, bottom + vec3<f32>(0.0, 0.0, third), 0.0);
+    let irradiance = texel.rgb / max(texel.a, 1e-6);
     return select(vec3<f32>(0.0), irradiance, environment_has_light_volume());
 }

@@ -1,7 +1,9 @@
 //! The environment on the GPU: its uniform, the atmosphere's tables, the clouds' shadow map and
 //! the light volume in one bind group ([`crate::shader::ENVIRONMENT_GROUP`]), as `environment.wgsl` declares them.
 
-use super::light_volume::{DiffuseOptics, LightVolumeGrid, LightVolumeSettings, MAX_CASCADES};
+use super::light_volume::{
+    DiffuseOptics, LightVolumeGrid, LightVolumeSettings, MAX_CASCADES, TABLE_PARTS,
+};
 use super::{Environment, SkyModel};
 use crate::atmosphere::Air;
 use crate::atmosphere::luts::{
@@ -232,7 +234,7 @@ pub struct TableSizes {
     /// Texels per side of the cloud shadow map.
     pub shadow_texels: u32,
     /// Cells of the light volume: one cascade's, the cascades side by side along z (the table
-    /// holds them twice along z: the radiance, then the current).
+    /// holds them [`TABLE_PARTS`] times along z).
     pub light_volume: UVec3,
 }
 
@@ -282,7 +284,12 @@ fn shapes(sizes: TableSizes) -> [TableShape; 7] {
             2,
             D2Array,
         ),
-        shape("light volume", (volume.x, volume.y), 2 * volume.z, D3),
+        shape(
+            "light volume",
+            (volume.x, volume.y),
+            TABLE_PARTS * volume.z,
+            D3,
+        ),
     ]
 }
 
@@ -520,6 +527,7 @@ fn environment_constants() -> String {
     crate::shader::wgsl_consts([
         ("SUN_PIXEL_ROWS", U32(super::SUN_PIXEL_ROWS)),
         ("LIGHT_VOLUME_MAX_CASCADES", U32(MAX_CASCADES)),
+        ("LIGHT_VOLUME_TABLE_PARTS", U32(TABLE_PARTS)),
     ])
 }
 

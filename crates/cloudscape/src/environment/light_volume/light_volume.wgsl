@@ -13,7 +13,7 @@
 @group(3) @binding(2) var<storage, read_write> volume_diffusion: array<f32>;
 // The environment's table as rgba16float texels (two packed u32 each), rows padded to
 // LIGHT_VOLUME_ROW_TEXELS for the copy into the 3-D texture: I0 of each cascade side by side along
-// z, then J / I0 the same way.
+// z, then J / I0 the same way, then the ground's irradiance under each column in the bottom row.
 @group(3) @binding(3) var<storage, read_write> volume_table_out: array<vec2<u32>>;
 
 const LIGHT_VOLUME_LUMINANCE = vec3<f32>(0.2126, 0.7152, 0.0722);
@@ -341,4 +341,16 @@ fn light_volume_export(@builtin(global_invocation_id) id: vec3<u32>) {
     let slice = c.z + v.cells.z * k;
     light_volume_store(vec3<u32>(c.x, c.y, slice), vec4<f32>(radiance, 1.0) * weight);
     light_volume_store(vec3<u32>(c.x, c.y, slice + v.cells.z * v.cascades), vec4<f32>(relative, 1.0) * weight);
+    if c.y == 0u {
+        light_volume_store(vec3<u32>(c.x, 0u, slice + 2u * v.cells.z * v.cascades), vec4<f32>(light_volume_bottom_irradiance(i, h.y), 1.0));
+    }
+}
+
+// The diffuse irradiance leaving the grid downward through the bottom face of bottom-row cell i
+// (Diffusion::bottom_irradiance): pi L entering from below plus the outward flux 4 pi J . n.
+fn light_volume_bottom_irradiance(i: u32, h_y: f32) -> vec3<f32> {
+    let face = light_volume_face_current(i, -1, h_y);
+    let entering = light_volume_entering(i, -1);
+    let radiance = volume_radiance[i].rgb;
+    return PI * (entering.alpha * radiance + entering.beta) + 4.0 * PI * (face[0] * radiance + face[1]);
 }

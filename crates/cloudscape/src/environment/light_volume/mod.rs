@@ -43,6 +43,9 @@ use glam::{UVec3, Vec3};
 pub const MAX_CASCADES: u32 = 4;
 /// Each cascade reaches this many times as far as the one inside it.
 pub const CASCADE_SCALE: f32 = 4.0;
+/// The table's parts along z, each the cascades' cells side by side: the radiance `I0`, the
+/// current over it, and the ground's diffuse irradiance under each column (its bottom row).
+pub const TABLE_PARTS: u32 = 3;
 
 /// The droplets' optics after δ-scaling (Wiscombe 1977's δ-M, as [`SunSlab::scaled`]).
 #[derive(Clone, Copy, Debug, PartialEq)]

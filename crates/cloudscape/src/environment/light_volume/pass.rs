@@ -3,7 +3,7 @@
 
 use super::inputs::{BEAM_GROWTH, BEAM_MIN_SUN_Y, BEAM_PATH_MAX_M, CELL_SAMPLE_OFFSET};
 use super::solve::MAX_COLUMN_CELLS;
-use super::{LightVolumeGrid, LightVolumeSettings};
+use super::{LightVolumeGrid, LightVolumeSettings, TABLE_PARTS};
 use crate::environment::{EnvironmentGpu, EnvironmentTable};
 use crate::gpu::pipeline::storage_buffer;
 use crate::gpu::{GpuContext, PassTimer};
@@ -57,7 +57,7 @@ impl LightVolumePass {
         let cascades = grid.cascades.len() as u64;
         let cells = u64::from(grid.cells.element_product()) * cascades;
         let n = grid.cells;
-        let table = 8 * u64::from(table_row_texels(n.x) * n.y * 2 * n.z) * cascades;
+        let table = 8 * u64::from(table_row_texels(n.x) * n.y * TABLE_PARTS * n.z) * cascades;
         let bytes = [16 * cells, 16 * cells, 4 * cells, table];
         if self
             .buffers
@@ -166,7 +166,7 @@ fn table_row_texels(width: u32) -> u32 {
     width.div_ceil(ROW_TEXELS) * ROW_TEXELS
 }
 
-/// Copies the staged table into the environment's texture (radiance, then current, along z).
+/// Copies the staged table into the environment's texture ([`TABLE_PARTS`] along z).
 fn copy_table(
     encoder: &mut wgpu::CommandEncoder,
     staged: &wgpu::Buffer,
@@ -174,7 +174,7 @@ fn copy_table(
     grid: &LightVolumeGrid,
 ) {
     let n = grid.cells;
-    let slices = 2 * n.z * grid.cascades.len() as u32;
+    let slices = TABLE_PARTS * n.z * grid.cascades.len() as u32;
     encoder.copy_buffer_to_texture(
         wgpu::TexelCopyBufferInfo {
             buffer: staged,

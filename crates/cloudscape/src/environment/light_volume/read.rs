@@ -6,7 +6,6 @@ use super::solve::{DiffuseField, Diffusion};
 use super::{DiffuseOptics, LightVolumeGrid, LightVolumeSettings};
 use crate::field::CloudField;
 use glam::{UVec3, Vec3};
-use std::f32::consts::PI;
 
 /// Least weight of a cell in the table's interpolation: clear air among clear air still
 /// interpolates.
@@ -62,14 +61,32 @@ impl LightVolume {
         radiance * (1.0 + 3.0 * g * current.dot(toward_eye)).max(0.0)
     }
 
-    /// The diffuse irradiance on level ground at `g` from the sky and the clouds above it (the
-    /// light of the grid's bottom face there): the downward hemisphere of the P1 radiance
-    /// `I0 + 3 J . w`, `E = pi I0 - 2 pi J_y` (`environment_light_volume_ground_irradiance`).
-    /// Under a clear sky it is the sky's irradiance; under a deck, what the deck passes on and
-    /// sends back of the ground's own light. None without a volume.
+    /// The diffuse irradiance on level ground at `g` from the sky and the clouds above it: what
+    /// leaves the grid's bottom face there ([`Diffusion::bottom_irradiance`], bilinear between the
+    /// columns' centres) (`environment_light_volume_ground_irradiance`). Under a clear sky it is
+    /// the sky's irradiance less what the clear column holds back; under a deck, what the deck
+    /// passes on and sends back of the ground's own light. None without a volume.
     pub fn ground_irradiance(&self, g: Vec3) -> Option<Vec3> {
-        let (radiance, current, _) = self.sample(g)?;
-        Some(PI * radiance * (1.0 - 2.0 * current.y).max(0.0))
+        if !self.enabled {
+            return None;
+        }
+        let (problem, solution) = self.cascade_at(g);
+        let n = problem.cells.as_vec3();
+        let local = ((g - problem.cascade.min_m) / problem.cascade.cell_m)
+            .clamp(Vec3::splat(0.5), n - 0.5)
+            - 0.5;
+        let base = local.floor().as_uvec3().min(problem.cells - 1);
+        let f = local - base.as_vec3();
+        let mut sum = Vec3::ZERO;
+        for corner in 0..4u32 {
+            let step = UVec3::new(corner & 1, 0, corner >> 1);
+            let c = (base + step).min(problem.cells - 1);
+            let c = UVec3::new(c.x, 0, c.z);
+            let w = if step.x == 1 { f.x } else { 1.0 - f.x }
+                * if step.z == 1 { f.z } else { 1.0 - f.z };
+            sum += w * problem.bottom_irradiance(solution, c);
+        }
+        Some(sum)
     }
 
     /// `I0`, the current over it and the droplets' mean cosine at `p` (clamped into the finest

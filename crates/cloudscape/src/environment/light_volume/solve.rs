@@ -294,6 +294,17 @@ impl Diffusion {
         (out[0], out[1])
     }
 
+    /// The diffuse irradiance leaving the grid downward through the bottom face of column cell
+    /// `c` (its bottom row): what enters there from below, `pi L`, plus the net outward flux
+    /// `4 pi J . n` of Marshak's face current.
+    pub fn bottom_irradiance(&self, field: &DiffuseField, c: UVec3) -> Vec3 {
+        let i = self.index(c);
+        let (coefficient, constant) = self.face_current(field, c, -1);
+        let (alpha, beta) = self.entering(c, -1);
+        let radiance = field.radiance[i];
+        PI * (alpha * radiance + beta) + 4.0 * PI * (coefficient * radiance + constant)
+    }
+
     /// The radiance entering the face of cell `c` on side `step` (+1 top, -1 bottom) as
     /// `L = alpha I0 + beta` per channel.
     fn entering(&self, c: UVec3, step: i32) -> (Vec3, Vec3) {
