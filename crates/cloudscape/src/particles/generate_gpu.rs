@@ -249,8 +249,28 @@ pub static PARTICLE_GENERATE_WGSL: crate::shader::WgslModule = crate::shader::wg
         &crate::frame::FRAME_WGSL,
         &crate::environment::ENVIRONMENT_WGSL,
         &super::gpu::PARTICLE_WGSL
-    ]
+    ],
+    generation_constants
 );
+
+/// The generation's constants as WGSL (the CPU specification's, `generate.rs` and `grid.rs`).
+fn generation_constants() -> String {
+    use super::generate::{
+        FULL_SIZE_DENSITY, MIN_DENSITY, OCCLUSION_MAX_DEPTH, OCCLUSION_PATH_M, OCCLUSION_STEPS,
+        RADIUS_PER_CELL,
+    };
+    use crate::shader::WgslConst::{F32, U32};
+    crate::shader::wgsl_consts([
+        ("CELL_JITTER", F32(super::grid::CELL_JITTER)),
+        ("RADIUS_PER_CELL", F32(RADIUS_PER_CELL)),
+        ("FULL_SIZE_DENSITY", F32(FULL_SIZE_DENSITY)),
+        ("MIN_DENSITY", F32(MIN_DENSITY)),
+        ("OCCLUSION_STEPS", U32(OCCLUSION_STEPS)),
+        ("OCCLUSION_PATH_M", F32(OCCLUSION_PATH_M)),
+        ("OCCLUSION_MAX_DEPTH", F32(OCCLUSION_MAX_DEPTH)),
+        ("GENERATE_WORKGROUP", U32(WORKGROUP)),
+    ])
+}
 
 #[cfg(test)]
 mod tests {

@@ -37,14 +37,8 @@ const COUNT_DROPPED: u32 = 3u;
 @group(3) @binding(3) var<storage, read_write> dispatches: array<u32, 6>;
 @group(3) @binding(4) var<storage, read_write> particles: array<Particle>;
 
-const CELL_JITTER: f32 = 0.25;
-const RADIUS_PER_CELL: f32 = 2.2;
-const FULL_SIZE_DENSITY: f32 = 0.1;
-const MIN_DENSITY: f32 = 0.01;
-const OCCLUSION_STEPS: u32 = 6u;
-const OCCLUSION_PATH_M: f32 = 4000.0;
-const OCCLUSION_MAX_DEPTH: f32 = 4.60517;
-const GENERATE_WORKGROUP: u32 = 64u;
+// CELL_JITTER, RADIUS_PER_CELL, FULL_SIZE_DENSITY, MIN_DENSITY, OCCLUSION_STEPS, OCCLUSION_PATH_M,
+// OCCLUSION_MAX_DEPTH and GENERATE_WORKGROUP come from generate.rs, grid.rs and generate_gpu.rs.
 
 struct Column {
     ring: u32,
@@ -150,7 +144,7 @@ fn weighted_density(ring: u32, p: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(weight, field_extinction_coarse(p) / generation.sigma_max_per_m);
 }
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(GENERATE_WORKGROUP)
 fn list_cells(@builtin(global_invocation_id) id: vec3<u32>) {
     let index = id.x;
     if index >= generation.column_count || field.layer_count == 0u {
@@ -231,7 +225,7 @@ fn particle_size(cell_m: f32, spacing: f32, thickness: f32, scale: f32) -> vec2<
 }
 
 // generate_cell.
-@compute @workgroup_size(64)
+@compute @workgroup_size(GENERATE_WORKGROUP)
 fn generate_particles(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= atomicLoad(&counts[COUNT_CELLS]) {
         return;
