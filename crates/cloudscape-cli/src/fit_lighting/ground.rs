@@ -4,7 +4,7 @@
 //! their bases) and with the shadow map alone (the sun dimmed by the clouds' diffuse
 //! transmittance, `optics::diffuse_transmittance`).
 
-use super::samples::training_scene;
+use super::samples::{mean_and_error, training_scene};
 use anyhow::{Result, anyhow};
 use cloudscape::environment::light_volume::inputs::VolumeLight;
 use cloudscape::environment::light_volume::{
@@ -81,23 +81,17 @@ pub fn ground_samples(
         .enumerate()
         .map(|(i, g)| {
             let mut rng = Rng::for_sample(0x9a0e, u64::from(index) << 32 | i as u64, 0);
-            let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
-            for _ in 0..paths {
-                let v = f64::from(
-                    tracer
-                        .ray_radiance(g + Vec3::Y, Vec3::NEG_Y, 10.0, &mut rng)
-                        .y,
-                );
-                sum += v;
-                sum_sq += v * v;
-            }
-            let n = f64::from(paths);
-            let mean = sum / n;
+            let down = || {
+                tracer
+                    .ray_radiance(g + Vec3::Y, Vec3::NEG_Y, 10.0, &mut rng)
+                    .y
+            };
+            let (radiance, error) = mean_and_error(paths, down);
             GroundSample {
                 scene: index,
                 point_m: g,
-                radiance: mean as f32,
-                error: ((sum_sq / n - mean * mean).max(0.0) / n).sqrt() as f32,
+                radiance,
+                error,
             }
         })
         .collect())

@@ -154,27 +154,36 @@ fn sample(
     // The march's light samples, at the middle of each segment.
     let tau_sun = light::sun_optical_depth(field, p, sun, (light_steps, 0.5), 0.0);
     let tau_back = light::back_optical_depth(field, p, sun, (back_steps(light_steps), 0.5), 0.0);
-    let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
-    for _ in 0..paths {
-        let v = f64::from(tracer.source_radiance(p, dir, rng).y);
-        sum += v;
-        sum_sq += v * v;
-    }
-    let n = f64::from(paths);
-    let mean = sum / n;
+    let (source, source_error) = mean_and_error(paths, || tracer.source_radiance(p, dir, rng).y);
     Some(Sample {
         scene: index,
         tau_sun,
         tau_back,
         cos_theta: dir.dot(sun),
         sun_y: sun.y,
-        source: mean as f32,
-        source_error: ((sum_sq / n - mean * mean).max(0.0) / n).sqrt() as f32,
+        source,
+        source_error,
         point_m: p,
         direction: dir,
         family,
         volume_diffuse: f32::NAN,
     })
+}
+
+/// The mean of `paths` estimates and its standard error.
+pub fn mean_and_error(paths: u32, mut estimate: impl FnMut() -> f32) -> (f32, f32) {
+    let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+    for _ in 0..paths {
+        let v = f64::from(estimate());
+        sum += v;
+        sum_sq += v * v;
+    }
+    let n = f64::from(paths);
+    let mean = sum / n;
+    (
+        mean as f32,
+        ((sum_sq / n - mean * mean).max(0.0) / n).sqrt() as f32,
+    )
 }
 
 /// Solves the light volume of training scene `index` (the scene's own settings, centred over the

@@ -71,20 +71,12 @@ impl LightVolume {
             return None;
         }
         let (problem, solution) = self.cascade_at(g);
-        let n = problem.cells.as_vec3();
-        let local = ((g - problem.cascade.min_m) / problem.cascade.cell_m)
-            .clamp(Vec3::splat(0.5), n - 0.5)
-            - 0.5;
-        let base = local.floor().as_uvec3().min(problem.cells - 1);
-        let f = local - base.as_vec3();
+        let (base, f) = interpolation_base(problem, g);
         let mut sum = Vec3::ZERO;
         for corner in 0..4u32 {
             let step = UVec3::new(corner & 1, 0, corner >> 1);
-            let c = (base + step).min(problem.cells - 1);
-            let c = UVec3::new(c.x, 0, c.z);
-            let w = if step.x == 1 { f.x } else { 1.0 - f.x }
-                * if step.z == 1 { f.z } else { 1.0 - f.z };
-            sum += w * problem.bottom_irradiance(solution, c);
+            let c = (base + step).min(problem.cells - 1).with_y(0);
+            sum += corner_weight(step, f.with_y(0.0)) * problem.bottom_irradiance(solution, c);
         }
         Some(sum)
     }
@@ -97,20 +89,14 @@ impl LightVolume {
             return None;
         }
         let (problem, solution) = self.cascade_at(p);
-        let n = problem.cells.as_vec3();
-        let local = ((p - problem.cascade.min_m) / problem.cascade.cell_m)
-            .clamp(Vec3::splat(0.5), n - 0.5)
-            - 0.5;
-        let base = local.floor().as_uvec3().min(problem.cells - 1);
-        let f = local - base.as_vec3();
+        let (base, f) = interpolation_base(problem, p);
         let (mut radiance, mut current, mut weights) = (Vec3::ZERO, Vec3::ZERO, 0.0);
         for corner in 0..8u32 {
             let step = UVec3::new(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
             let c = (base + step).min(problem.cells - 1);
-            let trilinear =
-                Vec3::select(step.cmpeq(UVec3::ONE), f, Vec3::ONE - f).element_product();
             let i = problem.index(c);
-            let w = trilinear * interpolation_weight(problem.inputs[i][3], problem.cascade.cell_m);
+            let w = corner_weight(step, f)
+                * interpolation_weight(problem.inputs[i][3], problem.cascade.cell_m);
             radiance += w * solution.radiance[i];
             current += w * problem.relative_current(solution, c);
             weights += w;
@@ -130,4 +116,20 @@ impl LightVolume {
             })
             .unwrap_or_else(|| self.cascades.last().expect("at least one cascade"))
     }
+}
+
+/// The cell below and behind `p` in `problem`'s grid (`p` clamped to the cells' centres) and the
+/// fractions of the way to the next cell along each axis.
+fn interpolation_base(problem: &Diffusion, p: Vec3) -> (UVec3, Vec3) {
+    let n = problem.cells.as_vec3();
+    let local = ((p - problem.cascade.min_m) / problem.cascade.cell_m)
+        .clamp(Vec3::splat(0.5), n - 0.5)
+        - 0.5;
+    let base = local.floor().as_uvec3().min(problem.cells - 1);
+    (base, local - base.as_vec3())
+}
+
+/// The trilinear weight of the corner `step` (0 or 1 per axis) at fractions `f`.
+fn corner_weight(step: UVec3, f: Vec3) -> f32 {
+    Vec3::select(step.cmpeq(UVec3::ONE), f, Vec3::ONE - f).element_product()
 }
