@@ -172,17 +172,9 @@ pub fn write(path: &std::path::Path, samples: &[GroundSample]) -> Result<()> {
 
 /// The samples in `path`; None when it is missing or not a ground samples file.
 pub fn read(path: &std::path::Path) -> Option<Vec<GroundSample>> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let mut lines = text.lines();
-    if lines.next() != Some(HEADER) {
-        return None;
-    }
-    lines
-        .map(|line| {
-            let v: Vec<f32> = line
-                .split(',')
-                .map(|x| x.parse().ok())
-                .collect::<Option<_>>()?;
+    super::csv_rows(path, HEADER)?
+        .into_iter()
+        .map(|v| {
             (v.len() == 5).then(|| GroundSample {
                 scene: v[0] as u32,
                 point_m: Vec3::new(v[1], 0.0, v[2]),

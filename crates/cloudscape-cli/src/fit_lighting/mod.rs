@@ -273,20 +273,13 @@ fn write(path: &Path, samples: &[Sample]) -> Result<()> {
 
 /// The samples of scene `index` in `path`; None when it is missing or not a samples file.
 fn read(path: &Path, index: u32) -> Result<Option<Vec<Sample>>> {
-    let Ok(text) = std::fs::read_to_string(path) else {
+    let Some(rows) = csv_rows(path, HEADER) else {
         return Ok(None);
     };
-    let mut lines = text.lines();
-    if lines.next() != Some(HEADER) {
-        return Ok(None);
-    }
     let (_, family) = samples::training_scene(index, false)?;
-    Ok(lines
-        .map(|line| {
-            let v: Vec<f32> = line
-                .split(',')
-                .map(|x| x.parse().ok())
-                .collect::<Option<_>>()?;
+    Ok(rows
+        .into_iter()
+        .map(|v| {
             (v.len() == 13).then(|| Sample {
                 scene: v[0] as u32,
                 tau_sun: v[1],
@@ -302,4 +295,17 @@ fn read(path: &Path, index: u32) -> Result<Option<Vec<Sample>>> {
             })
         })
         .collect())
+}
+
+/// The rows of numbers of the samples file `path` under `header`; None when it is missing, has
+/// another header or holds a value that is not a number.
+fn csv_rows(path: &Path, header: &str) -> Option<Vec<Vec<f32>>> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut lines = text.lines();
+    if lines.next() != Some(header) {
+        return None;
+    }
+    lines
+        .map(|line| line.split(',').map(|x| x.parse().ok()).collect())
+        .collect()
 }
