@@ -1,5 +1,5 @@
 //! Ctrl-C (SIGINT): every command stops at once, says so, and leaves no partial file (files being
-//! written are abandoned, `cloudscape::fsutil::exit_abandoning_writes`), exiting with 130. A
+//! written are abandoned, `cloudscape::fsutil::abandon_writes`), exiting with 130. A
 //! command that can use its work so far (`reference`) asks for a graceful stop instead: the first
 //! Ctrl-C raises [`stop_requested`], a second one abandons as above.
 
@@ -32,6 +32,21 @@ fn on_interrupt() {
         eprintln!("\ninterrupted: stopping (Ctrl-C again to abandon without writing)");
         return;
     }
+    cloudscape::fsutil::abandon_writes();
     eprintln!("\ninterrupted: stopped; no partial file was left");
-    cloudscape::fsutil::exit_abandoning_writes(INTERRUPTED_STATUS)
+    exit_now(INTERRUPTED_STATUS)
+}
+
+/// Ends the process without running the C library's exit handlers: they tear down the graphics
+/// driver (Mesa's llvmpipe) while the render thread may still be inside it, which corrupted the
+/// heap and ended the process by SIGABRT instead of 130.
+#[cfg(unix)]
+fn exit_now(code: i32) -> ! {
+    // SAFETY: `_exit` ends the process at once; stderr is unbuffered, so nothing is lost.
+    unsafe { libc::_exit(code) }
+}
+
+#[cfg(not(unix))]
+fn exit_now(code: i32) -> ! {
+    std::process::exit(code)
 }

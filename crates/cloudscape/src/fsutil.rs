@@ -1,5 +1,5 @@
 //! File-system helpers shared by every module that writes files: every file appears whole or not
-//! at all, also when the process is interrupted ([`exit_abandoning_writes`]).
+//! at all, also when the process is interrupted ([`abandon_writes`]).
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -7,15 +7,15 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// The temporary files being written now, and whether the process is exiting.
+/// The temporary files being written now, and whether they were abandoned ([`abandon_writes`]).
 struct Pending {
     files: Vec<PathBuf>,
-    exiting: bool,
+    abandoned: bool,
 }
 
 static PENDING: Mutex<Pending> = Mutex::new(Pending {
     files: Vec::new(),
-    exiting: false,
+    abandoned: false,
 });
 
 fn pending() -> std::sync::MutexGuard<'static, Pending> {
@@ -25,25 +25,25 @@ fn pending() -> std::sync::MutexGuard<'static, Pending> {
         .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
-/// Removes the temporary file of every write in progress and exits the process with `code`
-/// before any of them can complete (a host's Ctrl-C handler): the files being written are then
-/// left as they were, never partial.
-pub fn exit_abandoning_writes(code: i32) -> ! {
+/// Removes the temporary file of every write in progress and refuses new ones, so that the
+/// process can then end at once (a host's Ctrl-C handler) with no file left partial: the files
+/// being written are left as they were. Writes that try to complete afterwards fail with
+/// [`std::io::ErrorKind::Interrupted`].
+pub fn abandon_writes() {
     let mut pending = pending();
-    pending.exiting = true;
+    pending.abandoned = true;
     for file in pending.files.drain(..) {
         let _ = std::fs::remove_file(file);
     }
-    std::process::exit(code)
 }
 
-/// A temporary file being written: listed, so that [`exit_abandoning_writes`] removes it, until
+/// A temporary file being written: listed, so that [`abandon_writes`] removes it, until
 /// dropped. Writers that hand a temporary file to another process (an encoder) list it too.
 pub struct PendingFile(PathBuf);
 
 impl PendingFile {
     /// Lists `path`, a temporary file that another process creates and writes. Fails with
-    /// [`std::io::ErrorKind::Interrupted`] once the process is exiting.
+    /// [`std::io::ErrorKind::Interrupted`] once writes were abandoned.
     pub fn list(path: &Path) -> std::io::Result<PendingFile> {
         Self::list_with(path, |_| Ok(())).map(|(pending, ())| pending)
     }
@@ -58,10 +58,10 @@ impl PendingFile {
         make: impl FnOnce(&Path) -> std::io::Result<T>,
     ) -> std::io::Result<(PendingFile, T)> {
         let mut pending = pending();
-        if pending.exiting {
+        if pending.abandoned {
             return Err(std::io::Error::new(
                 std::io::ErrorKind::Interrupted,
-                "the process is exiting",
+                "writes were abandoned: the process is exiting",
             ));
         }
         let made = make(path)?;
