@@ -16,7 +16,7 @@ use crate::environment::Environment;
 use crate::field::noise::{hash_to_unit, pcg_hash};
 use crate::field::{CloudField, GOLDEN_RATIO_CONJUGATE};
 use crate::frame::Frame;
-use crate::scene::{PlanetShape, Scene};
+use crate::scene::{ParticleOcclusion, PlanetShape, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
@@ -82,8 +82,14 @@ pub struct Generation {
     pub sigma_max_per_m: f32,
     /// Mean density of the reference particle over its ball ([`super::density::RadialProfile::volume_mean`]).
     pub particle_mean_density: f32,
-    /// Whether the march toward the sun stops at [`OCCLUSION_MAX_DEPTH`].
+    /// How the particles' sunlight is occluded: [`ParticleOcclusion::March`] marches the field
+    /// in [`generate_cell`]; [`ParticleOcclusion::Tiles`] leaves it to [`super::occlusion`].
+    pub occlusion: ParticleOcclusion,
+    /// Whether the march or the walk toward the sun stops at [`OCCLUSION_MAX_DEPTH`].
     pub occlusion_early_exit: bool,
+    /// The altitudes the particles lie between, m (the layer band, its floor lowered by the
+    /// planet's curvature over the grid's reach); (0, 0) without layers.
+    pub band_m: (f32, f32),
 }
 
 impl Generation {
@@ -98,7 +104,9 @@ impl Generation {
             time_s: scene.render.time_s,
             sigma_max_per_m: super::ParticleTableSpec::from_scene(scene).extinction_per_m,
             particle_mean_density,
+            occlusion: scene.particles.occlusion,
             occlusion_early_exit: scene.particles.occlusion_early_exit,
+            band_m: particle_band_m(scene),
         }
     }
 
@@ -111,6 +119,24 @@ impl Generation {
             ..self
         }
     }
+}
+
+/// The altitudes a scene's particles lie between (`Generation::band_m`).
+fn particle_band_m(scene: &Scene) -> (f32, f32) {
+    let layers = &scene.layers;
+    let Some(bottom) = layers.iter().map(|l| l.bottom_m).reduce(f32::min) else {
+        return (0.0, 0.0);
+    };
+    let top = layers
+        .iter()
+        .map(|l| l.bottom_m + l.thickness_m)
+        .fold(bottom, f32::max);
+    let reach_m = RingGrid::from_scene(scene).reach_m();
+    let drop_m = match scene.planet.shape {
+        PlanetShape::Flat => 0.0,
+        PlanetShape::Spherical => reach_m * reach_m / (2.0 * scene.planet.radius_m),
+    };
+    (bottom - drop_m, top)
 }
 
 /// A listed column and the mask of its layers that hold cloud.
@@ -241,7 +267,12 @@ pub fn generate_cell(field: &CloudField, g: &Generation, cell: ListedCell) -> Ve
                 radius_m,
                 height_m,
                 density: density * weight * mass_scale,
-                sun_optical_depth: sun_optical_depth(field, g, (p, radius_m), march_jitter).0,
+                sun_optical_depth: match g.occlusion {
+                    ParticleOcclusion::March => {
+                        sun_optical_depth(field, g, (p, radius_m), march_jitter).0
+                    }
+                    ParticleOcclusion::Tiles => 0.0,
+                },
                 id,
                 optical_depth_up: ambient(top - altitude, up),
                 optical_depth_down: ambient(altitude - bottom, -up),

@@ -9,6 +9,7 @@ use super::generate::{Generation, ListedCell, Particle};
 use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{storage_buffer, uniform_buffer};
 use crate::pass::{ComputePass, Shared};
+use crate::scene::ParticleOcclusion;
 
 /// Most particles the GPU holds: the render pass packs a particle's index into 20 bits.
 pub const MAX_PARTICLES: u32 = 1 << 20;
@@ -30,7 +31,7 @@ struct GenerationUniform {
     column_count: u32,
     max_particles: u32,
     occlusion_early_exit: u32,
-    reserved: u32,
+    occlusion_march: u32,
 }
 
 impl GenerationUniform {
@@ -46,7 +47,7 @@ impl GenerationUniform {
             column_count: g.grid.column_count(),
             max_particles: capacity(g),
             occlusion_early_exit: u32::from(g.occlusion_early_exit),
-            reserved: 0,
+            occlusion_march: u32::from(g.occlusion == ParticleOcclusion::March),
         }
     }
 }
@@ -293,7 +294,7 @@ mod tests {
                 column_count,
                 max_particles,
                 occlusion_early_exit,
-                reserved,
+                occlusion_march,
             }
         );
         assert_wgsl_layout!(

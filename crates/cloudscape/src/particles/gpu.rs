@@ -298,6 +298,11 @@ pub static PARTICLE_LOOKUP_WGSL: crate::shader::WgslModule = crate::shader::wgsl
     [&crate::shader::MATH_WGSL, &PARTICLE_WGSL]
 );
 
+/// The sort of a tile's particle keys in workgroup memory (`particle_tiles.wgsl`): the screen
+/// tiles' and the light tiles'.
+pub static PARTICLE_TILES_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("particle_tiles", "particle_tiles.wgsl", []);
+
 /// The passes that bake the optical-depth table (`particle_bake.wgsl`).
 pub static PARTICLE_BAKE_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
     "particle_bake",

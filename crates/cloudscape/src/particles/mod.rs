@@ -17,6 +17,8 @@ pub mod generate;
 pub mod generate_gpu;
 pub mod gpu;
 pub(crate) mod grid;
+pub mod occlusion;
+pub mod occlusion_gpu;
 pub mod optical_depth;
 pub mod preview;
 pub mod render;

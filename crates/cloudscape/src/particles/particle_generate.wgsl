@@ -16,7 +16,7 @@ struct Generation {
     column_count: u32,
     max_particles: u32,            // capacity of `particles`
     occlusion_early_exit: u32,     // 1: stop the march toward the sun at OCCLUSION_MAX_DEPTH
-    reserved: u32,
+    occlusion_march: u32,          // 1: march the field toward the sun; 0: the light tiles will
 }
 
 struct ListedCell {
@@ -253,7 +253,10 @@ fn generate_particles(@builtin(global_invocation_id) id: vec3<u32>) {
         let cell_volume = column.cell_m * column.cell_m * spacing;
         let ball = 4.0 / 3.0 * PI * full.x * full.x * full.y;
         let mass_scale = cell_volume / (ball * generation.particle_mean_density);
-        let sun = sun_optical_depth(p, radius_m, id_random(pid, 5u));
+        var sun = vec2<f32>(0.0);
+        if generation.occlusion_march == 1u {
+            sun = sun_optical_depth(p, radius_m, id_random(pid, 5u));
+        }
         atomicAdd(&counts[COUNT_OCCLUSION_STEPS], u32(sun.y));
         let slot = atomicAdd(&counts[COUNT_PARTICLES], 1u);
         if slot >= generation.max_particles {

@@ -21,6 +21,10 @@ struct Render {
     ambient_scale: f32,            // scale of sky and ground light
     band_first_tile_row: u32,      // the first tile row this dispatch renders
     band_rows: vec2<u32>,          // texel rows [x, y) this dispatch writes
+    diffuse_from_volume: u32,      // 1: the light volume's diffuse light, not the tables' multiple
+    reserved0: u32,
+    reserved1: vec2<u32>,
+    slab_params: vec4<f32>,        // optics::SunSlab::params_to_gpu: the forward peak's beam
 }
 
 @group(3) @binding(0) var<uniform> render: Render;
@@ -35,7 +39,8 @@ struct Render {
 @group(3) @binding(6) var scattering_lut: texture_3d<f32>;
 @group(3) @binding(7) var scattering_sampler: sampler;
 @group(3) @binding(8) var<storage, read_write> tile_counts: array<atomic<u32>>;
-// Per tile, `tile_capacity` sort keys: quantised log distance << 20 | particle index.
+// Per tile, `tile_capacity` sort keys: quantised log distance << 20 | particle index
+// (particle_tiles.wgsl sorts them).
 @group(3) @binding(9) var<storage, read_write> tile_entries: array<u32>;
 @group(3) @binding(10) var host_depth: texture_2d<f32>;
 @group(3) @binding(11) var cloud_out: texture_storage_2d<rgba16float, write>;
@@ -44,7 +49,6 @@ struct Render {
 @group(3) @binding(13) var<storage, read_write> render_stats: array<atomic<u32>, 4>;
 
 const TILE: u32 = 16u;
-const MAX_TILE_ENTRIES: u32 = 2048u;
 const INDEX_BITS: u32 = 20u;
 const INDEX_MASK: u32 = 0xfffffu;
 const DISTANCE_LEVELS: f32 = 4095.0;
@@ -143,76 +147,6 @@ fn bin_particles(@builtin(global_invocation_id) id: vec3<u32>) {
     atomicAdd(&render_stats[3], 1u);
 }
 
-var<workgroup> tile_keys: array<u32, MAX_TILE_ENTRIES>;
-var<workgroup> tile_length: u32;
-// A long list's keys by the top 8 bits of their distance level, to keep the nearest.
-var<workgroup> tile_histogram: array<atomic<u32>, 256>;
-var<workgroup> tile_cut: vec2<u32>; // (first distance bin left out or partly kept, keys kept)
-var<workgroup> tile_fill: atomic<u32>;
-
-// Loads the tile's `listed` keys into workgroup memory: all of them when they fit, otherwise the
-// nearest MAX_TILE_ENTRIES (by a histogram of their distance, so the far ones a full tile drops
-// are the ones its nearer particles hide). Returns how many were loaded (uniform).
-fn load_tile_keys(first: u32, listed: u32, lane: u32) -> u32 {
-    if listed <= MAX_TILE_ENTRIES {
-        for (var i = lane; i < listed; i += TILE * TILE) {
-            tile_keys[i] = tile_entries[first + i];
-        }
-        return listed;
-    }
-    atomicStore(&tile_histogram[lane], 0u);
-    if lane == 0u {
-        atomicStore(&tile_fill, 0u);
-    }
-    workgroupBarrier();
-    for (var i = lane; i < listed; i += TILE * TILE) {
-        atomicAdd(&tile_histogram[tile_entries[first + i] >> 24u], 1u);
-    }
-    workgroupBarrier();
-    if lane == 0u {
-        var kept = 0u;
-        var bin = 0u;
-        while bin < 256u && kept + atomicLoad(&tile_histogram[bin]) <= MAX_TILE_ENTRIES {
-            kept += atomicLoad(&tile_histogram[bin]);
-            bin++;
-        }
-        tile_cut = vec2<u32>(bin, kept);
-    }
-    let cut = workgroupUniformLoad(&tile_cut);
-    for (var i = lane; i < listed; i += TILE * TILE) {
-        let key = tile_entries[first + i];
-        if (key >> 24u) <= cut.x {
-            let slot = atomicAdd(&tile_fill, 1u);
-            if slot < MAX_TILE_ENTRIES {
-                tile_keys[slot] = key;
-            }
-        }
-    }
-    workgroupBarrier();
-    return MAX_TILE_ENTRIES;
-}
-
-// Sorts the first `size` (a power of two) keys of the tile, ascending: a bitonic network over
-// workgroup memory, each invocation taking every 256th pair.
-fn sort_tile_keys(size: u32, lane: u32) {
-    for (var k = 2u; k <= size; k <<= 1u) {
-        for (var j = k >> 1u; j > 0u; j >>= 1u) {
-            for (var i = lane; i < size; i += TILE * TILE) {
-                let l = i ^ j;
-                if l > i {
-                    let a = tile_keys[i];
-                    let b = tile_keys[l];
-                    if (a > b) == ((i & k) == 0u) {
-                        tile_keys[i] = b;
-                        tile_keys[l] = a;
-                    }
-                }
-            }
-            workgroupBarrier();
-        }
-    }
-}
-
 // blend::PixelBlend.
 struct PixelBlend {
     has_record: bool,
@@ -296,10 +230,20 @@ fn particle_segment(p: Particle, o: vec3<f32>, d: vec3<f32>, t_max: f32, light: 
     let reference_opacity = max(1.0 - exp(-render.reference_optical_radius * mass), 1e-4);
     let single = min(sm.x / reference_opacity, render.albedo);
     let multiple = min(sm.y / reference_opacity, 1.0 / PI);
-    let sun = light.sun * (light.phase * single * exp(-p.sun_optical_depth) + multiple * exp(-MULTIPLE_OCCLUSION * p.sun_optical_depth));
+    let single_sun = light.sun * light.phase * single * exp(-p.sun_optical_depth);
+    if render.diffuse_from_volume == 1u && environment_has_light_volume() {
+        let middle = o + d * (0.5 * (near_m + far_m));
+        let diffuse = environment_light_volume_diffuse(middle, -d);
+        let sun_in = normalize(environment_sun_direction() / radii);
+        let own_tau = 0.5 * render.sigma_max_per_m * p.density * chord_mass(-sun_in, sun_in) / length(environment_sun_direction() / radii);
+        let slab = SlabModel(render.phase_lobes, render.slab_params);
+        let peak = light.sun * slab_peak_beam(slab, dot(d, environment_sun_direction()), p.sun_optical_depth + own_tau);
+        return BlendSegment(near_m, far_m, optical_depth, single_sun + peak + render.albedo * diffuse);
+    }
+    let multiple_sun = light.sun * multiple * exp(-MULTIPLE_OCCLUSION * p.sun_optical_depth);
     let share_from_below = frame_two_stream_share_from_below(p.optical_depth_up, p.optical_depth_down);
     let ambient = render.ambient_scale * mix(light.sky_above, light.from_below, share_from_below);
-    return BlendSegment(near_m, far_m, optical_depth, sun + render.albedo * ambient);
+    return BlendSegment(near_m, far_m, optical_depth, single_sun + multiple_sun + render.albedo * ambient);
 }
 
 // Distance to the ground along the ray (3e38 without one): field_ground_distance, for the planet
@@ -330,20 +274,7 @@ fn render_tiles(
 ) {
     let tile = vec2<u32>(group.x, group.y + render.band_first_tile_row);
     let tile_index = tile.y * render.tiles.x + tile.x;
-    if lane == 0u {
-        tile_length = min(atomicLoad(&tile_counts[tile_index]), render.tile_capacity);
-    }
-    let listed = workgroupUniformLoad(&tile_length);
-    let n = load_tile_keys(tile_index * render.tile_capacity, listed, lane);
-    var size = 1u;
-    while size < n {
-        size <<= 1u;
-    }
-    for (var i = n + lane; i < size; i += TILE * TILE) {
-        tile_keys[i] = 0xffffffffu;
-    }
-    workgroupBarrier();
-    sort_tile_keys(size, lane);
+    let n = load_sorted_tile(tile_index, render.tile_capacity, lane);
 
     let px = tile * TILE + local.xy;
     if px.x >= render.grid_size.x || px.y < render.band_rows.x || px.y >= render.band_rows.y {

@@ -13,6 +13,8 @@ use super::ParticleTableSpec;
 use super::blend::Blending;
 use super::generate::{Generation, Particle};
 use super::generate_gpu::{GenerationCounts, MAX_PARTICLES, ParticleGenerator, set_groups};
+use super::occlusion::LightTiles;
+use super::occlusion_gpu::LightOcclusion;
 use super::store::TableStore;
 use super::tables_gpu::ParticleTables;
 use crate::field::FieldError;
@@ -21,13 +23,13 @@ use crate::gpu::pipeline::{storage_buffer, uniform_buffer};
 use crate::gpu::{GpuContext, PassTimer};
 use crate::optics::PhaseLobes;
 use crate::pass::{BindGroupCache, ComputePass, Shared};
-use crate::scene::{PlanetShape, Scene};
+use crate::scene::{LightingModel, ParticleOcclusion, PlanetShape, Scene};
 use crate::technique::{Draws, FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 
 /// Output texels along each side of a screen tile (`TILE` in `particle_render.wgsl`).
 pub const TILE_TEXELS: u32 = 16;
-/// Particles a tile sorts and blends (`MAX_TILE_ENTRIES`): the sort runs in 8 KiB of workgroup
-/// memory. A tile that lists more keeps its nearest.
+/// Particles a tile sorts and blends (`MAX_TILE_ENTRIES` in `particle_tiles.wgsl`): the sort
+/// runs in 8 KiB of workgroup memory. A tile that lists more keeps its nearest.
 pub const TILE_SORTED: u32 = 2048;
 /// Most particles a tile's list holds (fewer where the lists would pass [`TILE_LIST_BYTES`]).
 pub const TILE_CAPACITY: u32 = 16384;
@@ -35,7 +37,12 @@ pub const TILE_CAPACITY: u32 = 16384;
 pub const TILE_LIST_BYTES: u64 = 96 << 20;
 
 /// The timed passes of a frame, in order.
-pub const PASS_NAMES: &[&str] = &["particles: generate", "particles: bin", "particles: render"];
+pub const PASS_NAMES: &[&str] = &[
+    "particles: generate",
+    "particles: bin",
+    "particles: render",
+    "particles: occlusion",
+];
 
 /// The `Render` uniform of `particle_render.wgsl`.
 #[repr(C)]
@@ -56,6 +63,10 @@ struct RenderUniform {
     ambient_scale: f32,
     band_first_tile_row: u32,
     band_rows: UVec2,
+    diffuse_from_volume: u32,
+    reserved0: u32,
+    reserved1: [u32; 2],
+    slab_params: Vec4,
 }
 
 /// What the particle technique counted in a frame.
@@ -120,6 +131,7 @@ pub struct ParticleRenderer {
     generation: Option<Generation>,
     still_divisor: u32,
     generator: Option<ParticleGenerator>,
+    occlusion: Option<LightOcclusion>,
     lists: Option<TileLists>,
     group: BindGroupCache,
     supplied: Option<Vec<Particle>>,
@@ -148,6 +160,7 @@ impl ParticleRenderer {
             generation: None,
             still_divisor: 1,
             generator: None,
+            occlusion: None,
             lists: None,
             group: BindGroupCache::default(),
             supplied: None,
@@ -163,6 +176,12 @@ impl ParticleRenderer {
     /// The particle buffers (for tests and tools: read them with [`ParticleGenerator::read`]).
     pub fn generator(&self) -> Option<&ParticleGenerator> {
         self.generator.as_ref()
+    }
+
+    /// The light tiles of the seed's occlusion (for tests and tools: [`LightOcclusion::read`]),
+    /// once a frame used them.
+    pub fn light_occlusion(&self) -> Option<&LightOcclusion> {
+        self.occlusion.as_ref()
     }
 
     /// The counts of the newest frame the GPU has finished (never waits).
@@ -185,6 +204,7 @@ impl ParticleRenderer {
         if self.tables.as_ref().is_none_or(|t| t.spec != spec) {
             self.tables = Some(ParticleTables::new(ctx, &spec, &self.store, &mut |_, _| {}));
             self.group.clear();
+            self.occlusion = None;
         }
         self.tables.as_ref().expect("loaded above")
     }
@@ -208,6 +228,13 @@ impl ParticleRenderer {
                 od.dir_azimuth,
             ],
             ambient_scale: scene.lighting.ambient_scale,
+            diffuse_from_volume: u32::from(scene.lighting.model == LightingModel::Volume),
+            slab_params: Vec4::from_array(
+                scene
+                    .lighting
+                    .sun_slab(PhaseLobes::from_scene(&scene.phase))
+                    .params_to_gpu(),
+            ),
             ..RenderUniform::zeroed()
         }
     }
@@ -260,21 +287,47 @@ impl ParticleRenderer {
         }
     }
 
-    /// Generates and bins this frame's particles.
+    /// The seed's tiled occlusion of generation `g`'s particles, when the scene asks for it.
+    fn encode_occlusion(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        g: &Generation,
+        timer: Option<&mut PassTimer>,
+    ) {
+        if g.occlusion != ParticleOcclusion::Tiles {
+            return;
+        }
+        let tiles = LightTiles::new(g);
+        if self.occlusion.as_ref().is_none_or(|o| !o.fits(&tiles)) {
+            self.occlusion = Some(LightOcclusion::new(ctx, &tiles));
+        }
+        let occlusion = self.occlusion.as_mut().expect("made above");
+        let generator = self.generator.as_ref().expect("made before encoding");
+        let tables = self.tables.as_ref().expect("configure loads the tables");
+        let writes = timer.and_then(|t| t.compute_pass_writes(PASS_NAMES[3]));
+        occlusion.encode(ctx, encoder, (g, generator, tables), writes);
+    }
+
+    /// Generates, occludes and bins this frame's particles.
     fn encode_particles(
-        &self,
+        &mut self,
+        ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         shared: &Shared,
         group: &wgpu::BindGroup,
         mut timer: Option<&mut PassTimer>,
     ) {
-        let generator = self.generator.as_ref().expect("made before encoding");
         if self.supplied.is_none() {
+            let generator = self.generator.as_ref().expect("made before encoding");
             let writes = timer
                 .as_deref_mut()
                 .and_then(|t| t.compute_pass_writes(PASS_NAMES[0]));
             generator.encode(encoder, shared, writes);
+            let g = self.generation.expect("prepare comes before encoding");
+            self.encode_occlusion(ctx, encoder, &g, timer.as_deref_mut());
         }
+        let generator = self.generator.as_ref().expect("made before encoding");
         let lists = self.lists.as_ref().expect("made before encoding");
         encoder.clear_buffer(&lists.counts, 0, None);
         let writes = timer.and_then(|t| t.compute_pass_writes(PASS_NAMES[1]));
@@ -312,6 +365,10 @@ impl Technique for ParticleRenderer {
         self.still_divisor
     }
 
+    fn reads_light_volume(&self) -> bool {
+        self.settings.diffuse_from_volume == 1
+    }
+
     fn configure(&mut self, ctx: &GpuContext, scene: &Scene, _: &Path) -> Result<(), FieldError> {
         let tables = self.load_tables(ctx, scene);
         let settings = Self::uniform(scene, tables);
@@ -339,6 +396,7 @@ impl Technique for ParticleRenderer {
         if self.generator.as_ref().is_none_or(|g| !g.fits(&generation)) {
             self.generator = Some(ParticleGenerator::new(ctx, shared, &generation));
             self.group.clear();
+            self.occlusion = None;
         }
         let generator = self.generator.as_ref().expect("made above");
         generator.set(ctx, &generation);
@@ -348,7 +406,7 @@ impl Technique for ParticleRenderer {
         self.ensure_lists(ctx, targets.output.size);
         let group = self.bind_group(ctx, targets);
         encoder.clear_buffer(&self.stats, 0, None);
-        self.encode_particles(encoder, shared, &group, timer);
+        self.encode_particles(ctx, encoder, shared, &group, timer);
     }
 
     fn encode(
@@ -409,8 +467,10 @@ pub static PARTICLE_RENDER_WGSL: crate::shader::WgslModule = crate::shader::wgsl
         &crate::frame::FRAME_WGSL,
         &crate::environment::ENVIRONMENT_WGSL,
         &crate::optics::phase::PHASE_WGSL,
+        &crate::optics::slab::SLAB_WGSL,
         &super::gpu::PARTICLE_WGSL,
         &super::gpu::PARTICLE_LOOKUP_WGSL,
+        &super::gpu::PARTICLE_TILES_WGSL,
         &super::blend::PARTICLE_BLEND_WGSL
     ]
 );
@@ -441,6 +501,10 @@ mod tests {
                 ambient_scale,
                 band_first_tile_row,
                 band_rows,
+                diffuse_from_volume,
+                reserved0,
+                reserved1,
+                slab_params,
             }
         );
     }

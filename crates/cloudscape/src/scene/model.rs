@@ -685,9 +685,22 @@ pub struct Particles {
     pub blending: ParticleBlending,
     /// Particles render at 1/divisor of the image resolution: 1, 2 or 4 (Yusov: 2).
     pub resolution_divisor: u32,
-    /// Stop each particle's march toward the sun once its light is below 1 % (Yusov's early
-    /// exit); off only to measure what it saves.
+    /// How each particle finds the light the clouds between it and the sun take away.
+    pub occlusion: ParticleOcclusion,
+    /// Stop each particle's march or walk toward the sun once its light is below 1 % (Yusov's
+    /// early exit); off only to measure what it saves.
     pub occlusion_early_exit: bool,
+}
+
+/// How the particle technique occludes each particle's sunlight (Yusov 2014, "Light occlusion").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, DocumentedVariants)]
+#[serde(rename_all = "snake_case")]
+pub enum ParticleOcclusion {
+    /// The seed's method: the particles binned from the sun into light-space tiles, each tile's
+    /// list sorted in light order, each particle walking its tile's list up to its own place.
+    Tiles,
+    /// Yusov's released code: a coarse march through the field toward the sun.
+    March,
 }
 
 /// How the particle technique blends particles that overlap along a view ray.
@@ -724,6 +737,7 @@ impl Default for Particles {
             distance_m: 200_000.0,
             blending: ParticleBlending::VolumeAware,
             resolution_divisor: 2,
+            occlusion: ParticleOcclusion::Tiles,
             occlusion_early_exit: true,
         }
     }

@@ -77,6 +77,7 @@ pub const SCENE: &[Knob<Scene>] = &[
     knob!(Scene, particles.distance_m, Between(1.0e3, 1.0e6), "m"),
     knob!(Scene, particles.blending, Listed, ""),
     knob!(Scene, particles.resolution_divisor, Between(1.0, 4.0), ""),
+    knob!(Scene, particles.occlusion, Listed, ""),
     knob!(Scene, particles.occlusion_early_exit, Listed, ""),
     knob!(Scene, sprites.field_clouds, Listed, ""),
     knob!(Scene, sprites.cloud_size_m, Between(200.0, 20_000.0), "m"),

@@ -5,8 +5,8 @@ use serde::Serialize;
 
 use super::{Field, FieldMut};
 use crate::scene::model::{
-    LightingModel, ParticleBlending, ParticleStyle, PhaseModel, PlanetShape, Quality, SkyModel,
-    SpriteLod, TableResolution, Technique, Tonemap, WeatherSource,
+    LightingModel, ParticleBlending, ParticleOcclusion, ParticleStyle, PhaseModel, PlanetShape,
+    Quality, SkyModel, SpriteLod, TableResolution, Technique, Tonemap, WeatherSource,
 };
 
 /// A type a knob can hold.
@@ -164,6 +164,7 @@ listed! {
     ParticleStyle { Smooth, Thresholded, Pyroclastic }
     TableResolution { Low, Standard, High }
     ParticleBlending { VolumeAware, Alpha }
+    ParticleOcclusion { Tiles, March }
     SpriteLod { Clusters, Billboards }
     Technique { Raymarch, Particles, Sprites }
     Quality { Low, Medium, High, Ultra }
