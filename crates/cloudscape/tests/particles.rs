@@ -112,10 +112,11 @@ fn close(a: f32, b: f32, relative: f32, absolute: f32) -> bool {
     (a - b).abs() <= absolute + relative * a.abs().max(b.abs())
 }
 
-/// The GPU makes the particles its CPU twin makes: the same count (under 1 % differ, where the
+/// The GPU makes the particles its CPU twin makes: the same count (under 2 % differ, where the
 /// field's density sits near the threshold and the GPU's filtered noise and weather differ from
-/// the CPU's by a few per cent, as `gpu_field` allows), and matched by id the
-/// same positions, sizes, densities and light occlusion.
+/// the CPU's by a few per cent, as `gpu_field` allows: both where a particle is made and the
+/// column span that sets its altitude), and matched by id the same positions, sizes, densities
+/// and light occlusion.
 #[test]
 fn gpu_particles_match_their_cpu_specification() {
     let ctx = GpuContext::for_tests();
@@ -159,20 +160,21 @@ fn gpu_particles_match_their_cpu_specification() {
         .collect();
     let unmatched = gpu.len() + cpu.len() - 2 * matched.len();
     assert!(
-        unmatched * 100 <= cpu.len(),
+        unmatched * 50 <= cpu.len(),
         "{unmatched} of {} particles differ between GPU and CPU",
         cpu.len()
     );
-    // Positions are exact up to the f32 rounding of a point 6360 km from the planet's centre
-    // (0.5 m). Densities and optical depths follow the field, whose GPU twin differs by up to 2 %
-    // of the peak at 1 % of points (`gpu_field`); a particle's mass-conserving density scales that
-    // up by its cell's volume over its own, so they agree in distribution: exactly at the median,
-    // within per cent for most.
+    // Horizontal positions are exact up to the f32 rounding of a point 6360 km from the planet's
+    // centre (0.5 m); altitudes follow the column's span, from the field. Densities and optical
+    // depths follow the field, whose GPU twin differs by up to 2 % of the peak at 1 % of points
+    // (`gpu_field`); a particle's mass-conserving density scales that up by its cell's volume
+    // over its own, so they agree in distribution: exactly at the median, within per cent for
+    // most.
+    let planet_centre = Vec3::new(0.0, -scene.planet.radius_m, 0.0);
+    let up = |p: &Particle| (p.centre_m - planet_centre).normalize();
     for (g, c) in &matched {
-        assert!(
-            (g.centre_m - c.centre_m).length() < 0.6,
-            "GPU {g:?}\nCPU {c:?}"
-        );
+        let across = (g.centre_m - c.centre_m).reject_from(up(c)).length();
+        assert!(across < 0.6, "GPU {g:?}\nCPU {c:?}");
         assert_eq!(g.ring, c.ring);
     }
     let quantiles = |f: &dyn Fn(&Particle, &Particle) -> Option<f32>| {
@@ -180,6 +182,7 @@ fn gpu_particles_match_their_cpu_specification() {
         e.sort_by(f32::total_cmp);
         [0.5, 0.9, 0.99].map(|q| e[((e.len() - 1) as f32 * q) as usize])
     };
+    let altitude = quantiles(&|g, c| Some((g.centre_m - c.centre_m).dot(up(c)).abs()));
     let relative = |a: f32, b: f32| (a - b).abs() / b.abs().max(1e-3);
     let radius = quantiles(&|g, c| Some(relative(g.radius_m, c.radius_m)));
     let density = quantiles(&|g, c| Some(relative(g.density, c.density)));
@@ -187,7 +190,14 @@ fn gpu_particles_match_their_cpu_specification() {
         (g.sun_optical_depth < 4.0 && c.sun_optical_depth < 4.0)
             .then(|| (g.sun_optical_depth - c.sun_optical_depth).abs())
     });
-    eprintln!("relative radius {radius:?}, density {density:?}; sun optical depth {sun:?}");
+    eprintln!(
+        "altitude {altitude:?} m, relative radius {radius:?}, density {density:?}; sun optical \
+         depth {sun:?}"
+    );
+    assert!(
+        altitude[0] < 0.6 && altitude[1] < 10.0,
+        "altitude {altitude:?}"
+    );
     assert!(radius[0] < 1e-4 && radius[1] < 0.03, "radius {radius:?}");
     assert!(density[0] < 0.01 && density[1] < 0.1, "density {density:?}");
     assert!(sun[0] < 0.01 && sun[1] < 0.1, "sun optical depth {sun:?}");

@@ -20,11 +20,12 @@ use crate::scene::{ParticleOcclusion, PlanetShape, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
-/// A particle's radius relative to its cell (Yusov's sample: size = cell x 2.2 x lerp(0.5, 1,
-/// noise) x saturate(density / 0.02), the size being the radius; peers.md): neighbours overlap
-/// several times over, so their sum is a smooth volume rather than a pile of balls (half of it,
-/// tried first, left the gaps between particles visible).
-pub const RADIUS_PER_CELL: f32 = 2.2;
+/// A particle's radius relative to its cell. Yusov's sample uses 2.2 (size = cell x 2.2 x
+/// lerp(0.5, 1, noise) x saturate(density / 0.02), the size being the radius; peers.md); with
+/// the particles stacked where the column's cloud is ([`column_span`]) that blurs every edge, and
+/// 1.2 measures closer to the path-traced field on every canonical layer scene
+/// (`docs/particles.md`); 1.1, tried first, left the gaps between the particles visible.
+pub const RADIUS_PER_CELL: f32 = 1.2;
 /// Field density (relative to the layers' peak) at which a particle reaches its full size;
 /// thinner cloud makes smaller particles.
 pub const FULL_SIZE_DENSITY: f32 = 0.1;
@@ -139,14 +140,88 @@ fn particle_band_m(scene: &Scene) -> (f32, f32) {
     (bottom - drop_m, top)
 }
 
-/// A listed column and the mask of its layers that hold cloud.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
+/// A listed column, the mask of its layers that hold cloud, and the altitudes they span.
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 #[repr(C)]
 pub struct ListedCell {
     /// Column index in the grid.
     pub column: u32,
     /// Bit `l` set when layer `l` holds a particle.
     pub layers: u32,
+    /// Where the column's cloud lies ([`column_span`]): its bottom and top altitudes, m.
+    pub span_m: [f32; 2],
+}
+
+/// Altitudes at which [`column_span`] reads the coarse field across the layer band.
+pub const SPAN_SAMPLES: u32 = 16;
+
+/// Where a column's cloud lies: the altitudes its particles are spread over, so that a deck
+/// thinner than the layer band (a stratus 100 m thick at the bottom of a 400 m band) gets its
+/// particles inside it rather than in the empty air around it. From [`SPAN_SAMPLES`] coarse-field
+/// samples at the column's centre, the density-weighted mean altitude `mu` and deviation `s`:
+/// `mu -/+ (sqrt(3) s + half a sample step)` (a uniform layer's half-thickness is `sqrt(3) s`),
+/// within the band; the whole band where the centre is clear. It moves continuously with the
+/// field, so particles drift with the cloud rather than jump between sample heights.
+pub fn column_span(field: &CloudField, g: &Generation, column: &Column) -> (f32, f32) {
+    let (bottom, top, _) = band(field, &g.grid).expect("a band where there are cells");
+    let step = (top - bottom) / SPAN_SAMPLES as f32;
+    let (mut weight, mut first, mut second) = (0.0, 0.0, 0.0);
+    for k in 0..SPAN_SAMPLES {
+        let altitude = bottom + (k as f32 + 0.5) * step;
+        let d =
+            field.coarse_extinction_per_m(world_point(field, column.centre_m, altitude), g.time_s);
+        let x = altitude - bottom;
+        weight += d;
+        first += d * x;
+        second += d * x * x;
+    }
+    if weight <= 0.0 {
+        return (bottom, top);
+    }
+    let mean = first / weight;
+    let deviation = (second / weight - mean * mean).max(0.0).sqrt();
+    let half = 3f32.sqrt() * deviation + 0.5 * step;
+    (
+        (bottom + mean - half).max(bottom),
+        (bottom + mean + half).min(top),
+    )
+}
+
+/// A column's particle layers over its span: bottom and top altitudes, m; `fill`, the layers the
+/// band's spacing puts in that height (1..=cell_layers, fractional), and their spacing, m. The
+/// layers are `ceil(fill)`, the last one weighted by the fraction it holds, so that a column's
+/// particles move and fade continuously as its span changes (no popping), and the column's mass
+/// is its cloud's whatever the fraction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Span {
+    bottom_m: f32,
+    top_m: f32,
+    fill: f32,
+    spacing_m: f32,
+}
+
+impl Span {
+    fn new(field: &CloudField, g: &Generation, (bottom_m, top_m): (f32, f32)) -> Span {
+        let (_, _, band_spacing) = band(field, &g.grid).expect("a band where there are cells");
+        let height = top_m - bottom_m;
+        let fill = (height / band_spacing).clamp(1.0, g.grid.cell_layers as f32);
+        Span {
+            bottom_m,
+            top_m,
+            fill,
+            spacing_m: height / fill,
+        }
+    }
+
+    /// Its layers.
+    fn layers(&self) -> u32 {
+        self.fill.ceil() as u32
+    }
+
+    /// The weight of `layer`: 1, the last one its fraction.
+    fn layer_weight(&self, layer: u32) -> f32 {
+        (self.fill - layer as f32).min(1.0)
+    }
 }
 
 /// The stable identity of the particle in `layer` of a ring's lattice cell.
@@ -182,19 +257,16 @@ fn band(field: &CloudField, grid: &RingGrid) -> Option<(f32, f32, f32)> {
     Some((bottom, top, (top - bottom) / grid.cell_layers as f32))
 }
 
-/// Where particle `layer` of `column` sits, and its id.
-fn particle_position(
-    field: &CloudField,
-    g: &Generation,
-    column: &Column,
-    layer: u32,
-) -> (Vec3, u32) {
-    let (bottom, top, spacing) = band(field, &g.grid).expect("a band where there are cells");
+/// Where particle `layer` of `column` sits in its span, and its id.
+fn particle_position(field: &CloudField, column: &Column, span: &Span, layer: u32) -> (Vec3, u32) {
     let id = particle_id(column.ring, column.lattice, layer);
     let [jx, jz, jy] = id_randoms::<3>(id).map(|u| (2.0 * u - 1.0) * CELL_JITTER);
     let xz = column.centre_m + Vec2::new(jx, jz) * column.cell_m;
-    let altitude = (bottom + (layer as f32 + 0.5 + jy) * spacing).clamp(bottom, top);
-    (world_point(field, xz, altitude), id)
+    let altitude = span.bottom_m + (layer as f32 + 0.5 + jy) * span.spacing_m;
+    (
+        world_point(field, xz, altitude.clamp(span.bottom_m, span.top_m)),
+        id,
+    )
 }
 
 /// The ring weight and relative field density of a particle position.
@@ -211,14 +283,17 @@ pub fn list_cell(field: &CloudField, g: &Generation, index: u32) -> Option<Liste
     let column = g
         .grid
         .column(index, Vec2::new(g.camera_m.x, g.camera_m.z))?;
-    let layers = (0..g.grid.cell_layers).fold(0, |mask, layer| {
-        let (p, _) = particle_position(field, g, &column, layer);
+    let span_m = column_span(field, g, &column);
+    let span = Span::new(field, g, span_m);
+    let layers = (0..span.layers()).fold(0, |mask, layer| {
+        let (p, _) = particle_position(field, &column, &span, layer);
         let (weight, density) = weighted_density(field, g, column.ring, p);
         mask | (u32::from(weight > 0.0 && density > MIN_DENSITY) << layer)
     });
     (layers != 0).then_some(ListedCell {
         column: index,
         layers,
+        span_m: [span_m.0, span_m.1],
     })
 }
 
@@ -235,11 +310,13 @@ pub fn list_cells(field: &CloudField, g: &Generation) -> Vec<ListedCell> {
 pub fn generate_cell(field: &CloudField, g: &Generation, cell: ListedCell) -> Vec<Particle> {
     let camera = Vec2::new(g.camera_m.x, g.camera_m.z);
     let column = g.grid.column(cell.column, camera).expect("a listed column");
-    let (bottom, top, spacing) = band(field, &g.grid).expect("a band where there are cells");
-    (0..g.grid.cell_layers)
+    let (bottom, top, _) = band(field, &g.grid).expect("a band where there are cells");
+    let span = Span::new(field, g, (cell.span_m[0], cell.span_m[1]));
+    let spacing = span.spacing_m;
+    (0..span.layers())
         .filter(|layer| cell.layers & (1 << layer) != 0)
         .map(|layer| {
-            let (p, id) = particle_position(field, g, &column, layer);
+            let (p, id) = particle_position(field, &column, &span, layer);
             let (weight, density) = weighted_density(field, g, column.ring, p);
             let [_, _, _, size_noise, march_jitter] = id_randoms::<5>(id);
             let full_scale = 0.5 + 0.5 * size_noise;
@@ -247,7 +324,7 @@ pub fn generate_cell(field: &CloudField, g: &Generation, cell: ListedCell) -> Ve
             let size = |scale: f32| {
                 let radius_m = column.cell_m * RADIUS_PER_CELL * scale;
                 let height_m = radius_m.max(0.75 * spacing * scale);
-                (radius_m, height_m.min(0.5 * (top - bottom)))
+                (radius_m, height_m.min(0.5 * (span.top_m - span.bottom_m)))
             };
             let (radius_m, height_m) = size(full_scale * grown);
             let altitude = field.planet.altitude_m(p);
@@ -266,7 +343,7 @@ pub fn generate_cell(field: &CloudField, g: &Generation, cell: ListedCell) -> Ve
                 centre_m: p,
                 radius_m,
                 height_m,
-                density: density * weight * mass_scale,
+                density: density * weight * span.layer_weight(layer) * mass_scale,
                 sun_optical_depth: match g.occlusion {
                     ParticleOcclusion::March => {
                         sun_optical_depth(field, g, (p, radius_m), march_jitter).0

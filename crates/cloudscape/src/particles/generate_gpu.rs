@@ -258,7 +258,7 @@ pub static PARTICLE_GENERATE_WGSL: crate::shader::WgslModule = crate::shader::wg
 fn generation_constants() -> String {
     use super::generate::{
         FULL_SIZE_DENSITY, MIN_DENSITY, OCCLUSION_MAX_DEPTH, OCCLUSION_PATH_M, OCCLUSION_STEPS,
-        RADIUS_PER_CELL,
+        RADIUS_PER_CELL, SPAN_SAMPLES,
     };
     use crate::shader::WgslConst::{F32, U32};
     crate::shader::wgsl_consts([
@@ -267,6 +267,7 @@ fn generation_constants() -> String {
         ("FULL_SIZE_DENSITY", F32(FULL_SIZE_DENSITY)),
         ("MIN_DENSITY", F32(MIN_DENSITY)),
         ("OCCLUSION_STEPS", U32(OCCLUSION_STEPS)),
+        ("SPAN_SAMPLES", U32(SPAN_SAMPLES)),
         ("OCCLUSION_PATH_M", F32(OCCLUSION_PATH_M)),
         ("OCCLUSION_MAX_DEPTH", F32(OCCLUSION_MAX_DEPTH)),
         ("GENERATE_WORKGROUP", U32(WORKGROUP)),
@@ -316,7 +317,11 @@ mod tests {
         assert_wgsl_layout!(
             &crate::particles::generate_gpu::PARTICLE_GENERATE_WGSL,
             "ListedCell",
-            crate::particles::generate::ListedCell { column, layers }
+            crate::particles::generate::ListedCell {
+                column,
+                layers,
+                span_m
+            }
         );
         assert_wgsl_layout!(
             &crate::particles::render::PARTICLE_RENDER_WGSL,

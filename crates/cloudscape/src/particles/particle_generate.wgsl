@@ -21,7 +21,17 @@ struct Generation {
 
 struct ListedCell {
     column: u32,
-    layers: u32, // bit l: layer l holds a particle
+    layers: u32,       // bit l: layer l holds a particle
+    span_m: vec2<f32>, // column_span: the altitudes the column's particles spread over
+}
+
+// Span: a column's particle layers over its span (ceil(fill) layers, the last one weighted by
+// its fraction).
+struct Span {
+    bottom_m: f32,
+    top_m: f32,
+    fill: f32,
+    spacing_m: f32,
 }
 
 // [0] listed cells, [1] particles, [2] occlusion segments marched, [3] particles beyond capacity.
@@ -38,7 +48,7 @@ const COUNT_DROPPED: u32 = 3u;
 @group(3) @binding(4) var<storage, read_write> particles: array<Particle>;
 
 // CELL_JITTER, RADIUS_PER_CELL, FULL_SIZE_DENSITY, MIN_DENSITY, OCCLUSION_STEPS, OCCLUSION_PATH_M,
-// OCCLUSION_MAX_DEPTH and GENERATE_WORKGROUP come from generate.rs, grid.rs and generate_gpu.rs.
+// OCCLUSION_MAX_DEPTH, SPAN_SAMPLES and GENERATE_WORKGROUP come from generate.rs, grid.rs and generate_gpu.rs.
 
 struct Column {
     ring: u32,
@@ -128,13 +138,49 @@ fn band_spacing() -> f32 {
     return (field.layer_top_m - field.layer_bottom_m) / f32(generation.cell_layers);
 }
 
+// column_span.
+fn column_span(column: Column) -> vec2<f32> {
+    let bottom = field.layer_bottom_m;
+    let top = field.layer_top_m;
+    let step = (top - bottom) / f32(SPAN_SAMPLES);
+    var weight = 0.0;
+    var first = 0.0;
+    var second = 0.0;
+    for (var k = 0u; k < SPAN_SAMPLES; k++) {
+        let altitude = bottom + (f32(k) + 0.5) * step;
+        let d = field_extinction_coarse(world_point(column.centre_m, altitude));
+        let x = altitude - bottom;
+        weight += d;
+        first += d * x;
+        second += d * x * x;
+    }
+    if weight <= 0.0 {
+        return vec2<f32>(bottom, top);
+    }
+    let mean = first / weight;
+    let deviation = sqrt(max(second / weight - mean * mean, 0.0));
+    let half = sqrt(3.0) * deviation + 0.5 * step;
+    return vec2<f32>(max(bottom + mean - half, bottom), min(bottom + mean + half, top));
+}
+
+// Span::new.
+fn column_layers(span_m: vec2<f32>) -> Span {
+    let height = span_m.y - span_m.x;
+    let fill = clamp(height / band_spacing(), 1.0, f32(generation.cell_layers));
+    return Span(span_m.x, span_m.y, fill, height / fill);
+}
+
+// Span::layers.
+fn span_layers(span: Span) -> u32 {
+    return u32(ceil(span.fill));
+}
+
 // particle_position: the point, and the id in w (as bits).
-fn particle_position(column: Column, layer: u32) -> vec4<f32> {
+fn particle_position(column: Column, span: Span, layer: u32) -> vec4<f32> {
     let id = particle_id(column.ring, column.lattice, layer);
     let jitter = (2.0 * vec3<f32>(id_random(id, 1u), id_random(id, 2u), id_random(id, 3u)) - 1.0) * CELL_JITTER;
     let xz = column.centre_m + jitter.xy * column.cell_m;
-    let spacing = band_spacing();
-    let altitude = clamp(field.layer_bottom_m + (f32(layer) + 0.5 + jitter.z) * spacing, field.layer_bottom_m, field.layer_top_m);
+    let altitude = clamp(span.bottom_m + (f32(layer) + 0.5 + jitter.z) * span.spacing_m, span.bottom_m, span.top_m);
     return vec4<f32>(world_point(xz, altitude), bitcast<f32>(id));
 }
 
@@ -154,15 +200,17 @@ fn list_cells(@builtin(global_invocation_id) id: vec3<u32>) {
     if !column.valid {
         return;
     }
+    let span_m = column_span(column);
+    let span = column_layers(span_m);
     var layers = 0u;
-    for (var layer = 0u; layer < generation.cell_layers; layer++) {
-        let p = particle_position(column, layer).xyz;
+    for (var layer = 0u; layer < span_layers(span); layer++) {
+        let p = particle_position(column, span, layer).xyz;
         let wd = weighted_density(column.ring, p);
         layers |= select(0u, 1u, wd.x > 0.0 && wd.y > MIN_DENSITY) << layer;
     }
     if layers != 0u {
         let slot = atomicAdd(&counts[COUNT_CELLS], 1u);
-        listed_cells[slot] = ListedCell(index, layers);
+        listed_cells[slot] = ListedCell(index, layers, span_m);
     }
 }
 
@@ -232,13 +280,14 @@ fn generate_particles(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let cell = listed_cells[id.x];
     let column = grid_column(cell.column);
-    let spacing = band_spacing();
-    let thickness = field.layer_top_m - field.layer_bottom_m;
-    for (var layer = 0u; layer < generation.cell_layers; layer++) {
+    let span = column_layers(cell.span_m);
+    let spacing = span.spacing_m;
+    let thickness = span.top_m - span.bottom_m;
+    for (var layer = 0u; layer < span_layers(span); layer++) {
         if (cell.layers & (1u << layer)) == 0u {
             continue;
         }
-        let at = particle_position(column, layer);
+        let at = particle_position(column, span, layer);
         let p = at.xyz;
         let pid = bitcast<u32>(at.w);
         let wd = weighted_density(column.ring, p);
@@ -267,7 +316,7 @@ fn generate_particles(@builtin(global_invocation_id) id: vec3<u32>) {
             p,
             radius_m,
             height_m,
-            wd.y * wd.x * mass_scale,
+            wd.y * wd.x * min(span.fill - f32(layer), 1.0) * mass_scale,
             sun.x,
             pid,
             ambient_optical_depth(p, field.layer_top_m - altitude, up),
