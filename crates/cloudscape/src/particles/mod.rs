@@ -7,7 +7,10 @@
 //! - [`scattering`]: single and multiple scattering of the spherically symmetric particle, order by
 //!   order;
 //! - [`table_file`]: table files and their keys; [`store`]: the shipped tables and the cache;
-//! - [`preview`]: orthographic pictures of the particle as the tables shade it.
+//! - [`preview`]: orthographic pictures of the particle as the tables shade it;
+//! - [`generate`] (CPU specification), [`generate_gpu`]: the particles from the cloud field;
+//! - [`occlusion`] (CPU specification), [`occlusion_gpu`]: the seed's tiled light occlusion;
+//! - [`blend`], [`render`]: the particle technique's blending and rendering.
 //!
 //! [`ParticleTableSpec`] gathers, from a scene, every input of the tables.
 

@@ -1,7 +1,8 @@
 // Particle rendering in compute (particles/render.rs): the particles of particle_generate.wgsl
 // binned into screen tiles (`bin_particles`, one invocation per particle), then one workgroup per
 // tile (`render_tiles`) that sorts the tile's list by distance and blends, per pixel, the segment of
-// the view ray through each particle, shaded from the tables, front to back with Yusov 2014's
+// the view ray through each particle, shaded from the tables (single scattering) and the light
+// volume (multiple scattering, lighting.model = "volume"), front to back with Yusov 2014's
 // volume-aware blending (particles/blend.rs is its specification). wgpu has no rasterizer-ordered
 // views, so the ordering the seed gets from pixel synchronisation comes from the sort.
 
