@@ -292,35 +292,59 @@ fn environment_cloud_sun_transmittance(p: vec3<f32>) -> f32 {
     return exp(-environment_cloud_sun_optical_depth(p));
 }
 
-// Texture coordinates of world point p in the light volume's radiance (its current lies a third of
-// the texture further along z, the ground's irradiance two thirds): the finest cascade holding p (within half a cell of its sides), else
-// the coarsest, clamped to its cells' centres so that no neighbouring cascade bleeds in.
-fn environment_light_volume_uvw(p: vec3<f32>) -> vec3<f32> {
+// Texture coordinates of world point p in cascade k of the light volume's radiance (its current
+// lies a third of the texture further along z, the ground's irradiance two thirds), clamped to the
+// cascade's cells' centres so that no neighbouring cascade bleeds in.
+fn environment_light_volume_uvw(p: vec3<f32>, k: u32) -> vec3<f32> {
     let v = environment.light_volume;
     let n = vec3<f32>(v.cells);
-    var k = v.cascades - 1u;
-    for (var c = v.cascades; c > 0u; c--) {
-        let local = (p - v.cascade_min_m[c - 1u].xyz) / v.cascade_cell_m[c - 1u].xyz;
-        let inside = all(local.xz >= vec2<f32>(0.5)) && all(local.xz <= n.xz - 0.5);
-        k = select(k, c - 1u, inside);
-    }
     let local = clamp((p - v.cascade_min_m[k].xyz) / v.cascade_cell_m[k].xyz, vec3<f32>(0.5), n - 0.5);
     return vec3<f32>(local.x / n.x, local.y / n.y, (local.z + n.z * f32(k)) / (f32(LIGHT_VOLUME_TABLE_PARTS) * n.z * f32(v.cascades)));
 }
 
+// How much cascade k's own value counts at p (cascade_weight): 1 from CASCADE_BLEND_CELLS inside
+// its sides inward, falling linearly to 0 at its outermost cells' centres; the coarsest takes the
+// rest.
+fn environment_light_volume_cascade_weight(p: vec3<f32>, k: u32) -> f32 {
+    let v = environment.light_volume;
+    if k + 1u == v.cascades {
+        return 1.0;
+    }
+    let n = vec3<f32>(v.cells);
+    let local = (p - v.cascade_min_m[k].xyz) / v.cascade_cell_m[k].xyz;
+    let inside = min(min(local.x - 0.5, local.z - 0.5), min(n.x - 0.5 - local.x, n.z - 0.5 - local.z));
+    return clamp(inside / CASCADE_BLEND_CELLS, 0.0, 1.0);
+}
+
 // The light volume's I0 (rgb) and its current over it (LightVolume::sample) at world point p,
-// clamped into the finest cascade holding it, interpolated with the cells' weights (their optical
-// thickness: a point in a cloud's edge reads the cloud's cells more than the clear air beside them).
+// interpolated with the cells' weights (their optical thickness: a point in a cloud's edge reads
+// the cloud's cells more than the clear air beside them), the cascades blended finest first
+// (LightVolume::blend_cascades).
 struct LightVolumeSample {
     radiance: vec3<f32>,
     current: vec3<f32>,
 }
 
-fn environment_light_volume_sample(p: vec3<f32>) -> LightVolumeSample {
-    let uvw = environment_light_volume_uvw(p);
+fn environment_light_volume_sample_in(p: vec3<f32>, k: u32) -> LightVolumeSample {
+    let uvw = environment_light_volume_uvw(p, k);
     let weighted = textureSampleLevel(environment_light_volume, environment_linear, uvw, 0.0);
     let weighted_current = textureSampleLevel(environment_light_volume, environment_linear, uvw + vec3<f32>(0.0, 0.0, 1.0 / f32(LIGHT_VOLUME_TABLE_PARTS)), 0.0);
     return LightVolumeSample(weighted.rgb / max(weighted.a, 1e-6), weighted_current.xyz / max(weighted_current.a, 1e-6));
+}
+
+fn environment_light_volume_sample(p: vec3<f32>) -> LightVolumeSample {
+    var sum = LightVolumeSample(vec3<f32>(0.0), vec3<f32>(0.0));
+    var left = 1.0;
+    for (var k = 0u; k < environment.light_volume.cascades && left > 0.0; k++) {
+        let w = environment_light_volume_cascade_weight(p, k);
+        if w > 0.0 {
+            let s = environment_light_volume_sample_in(p, k);
+            sum.radiance += left * w * s.radiance;
+            sum.current += left * w * s.current;
+            left *= 1.0 - w;
+        }
+    }
+    return sum;
 }
 
 // Whether the frame has a light volume (a technique reads it and there are clouds).
@@ -343,9 +367,17 @@ fn environment_light_volume_diffuse(p: vec3<f32>, toward_eye: vec3<f32>) -> vec3
 // volume's bottom face there, the table's third part, bilinear between columns
 // (LightVolume::ground_irradiance). Zero without a volume.
 fn environment_light_volume_ground_irradiance(g: vec3<f32>) -> vec3<f32> {
-    let bottom = environment_light_volume_uvw(vec3<f32>(g.x, -1e9, g.z));
     let third = 2.0 / f32(LIGHT_VOLUME_TABLE_PARTS);
-    let texel = textureSampleLevel(environment_light_volume, environment_linear, bottom + vec3<f32>(0.0, 0.0, third), 0.0);
-    let irradiance = texel.rgb / max(texel.a, 1e-6);
+    var irradiance = vec3<f32>(0.0);
+    var left = 1.0;
+    for (var k = 0u; k < environment.light_volume.cascades && left > 0.0; k++) {
+        let w = environment_light_volume_cascade_weight(g, k);
+        if w > 0.0 {
+            let bottom = environment_light_volume_uvw(vec3<f32>(g.x, -1e9, g.z), k);
+            let texel = textureSampleLevel(environment_light_volume, environment_linear, bottom + vec3<f32>(0.0, 0.0, third), 0.0);
+            irradiance += left * w * texel.rgb / max(texel.a, 1e-6);
+            left *= 1.0 - w;
+        }
+    }
     return select(vec3<f32>(0.0), irradiance, environment_has_light_volume());
 }

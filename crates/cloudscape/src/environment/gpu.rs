@@ -523,11 +523,15 @@ pub static ENVIRONMENT_WGSL: crate::shader::WgslModule = crate::shader::wgsl_mod
 
 /// The environment's constants as WGSL.
 fn environment_constants() -> String {
-    use crate::shader::WgslConst::U32;
+    use crate::shader::WgslConst::{F32, U32};
     crate::shader::wgsl_consts([
         ("SUN_PIXEL_ROWS", U32(super::SUN_PIXEL_ROWS)),
         ("LIGHT_VOLUME_MAX_CASCADES", U32(MAX_CASCADES)),
         ("LIGHT_VOLUME_TABLE_PARTS", U32(TABLE_PARTS)),
+        (
+            "CASCADE_BLEND_CELLS",
+            F32(super::light_volume::CASCADE_BLEND_CELLS),
+        ),
     ])
 }
 

@@ -31,7 +31,7 @@ pub mod solve;
 mod tests;
 
 pub use pass::{LIGHT_VOLUME_PASS_NAMES, LIGHT_VOLUME_WGSL, LightVolumePass};
-pub use read::LightVolume;
+pub use read::{CASCADE_BLEND_CELLS, LightVolume};
 pub use solve::{Boundaries, DiffuseField, Diffusion};
 
 use crate::field::CloudField;

@@ -52,8 +52,8 @@ impl LightVolume {
     }
 
     /// The diffuse light at `p` scattered toward the eye along `toward_eye` (unit), per unit
-    /// scattering coefficient: `I0 (1 + 3 g J / I0 . w)` interpolated trilinearly in the finest
-    /// cascade holding `p` (`environment_light_volume_diffuse`).
+    /// scattering coefficient: `I0 (1 + 3 g J / I0 . w)` interpolated trilinearly in the cascades
+    /// holding `p` (`environment_light_volume_diffuse`).
     pub fn diffuse(&self, p: Vec3, toward_eye: Vec3) -> Vec3 {
         let Some((radiance, current, g)) = self.sample(p) else {
             return Vec3::ZERO;
@@ -67,28 +67,36 @@ impl LightVolume {
     /// the sky's irradiance less what the clear column holds back; under a deck, what the deck
     /// passes on and sends back of the ground's own light. None without a volume.
     pub fn ground_irradiance(&self, g: Vec3) -> Option<Vec3> {
-        if !self.enabled {
-            return None;
-        }
-        let (problem, solution) = self.cascade_at(g);
-        let (base, f) = interpolation_base(problem, g);
-        let mut sum = Vec3::ZERO;
-        for corner in 0..4u32 {
-            let step = UVec3::new(corner & 1, 0, corner >> 1);
-            let c = (base + step).min(problem.cells - 1).with_y(0);
-            sum += corner_weight(step, f.with_y(0.0)) * problem.bottom_irradiance(solution, c);
-        }
-        Some(sum)
+        self.enabled.then(|| {
+            self.blend_cascades(g, |(problem, solution)| {
+                let (base, f) = interpolation_base(problem, g);
+                let mut sum = Vec3::ZERO;
+                for corner in 0..4u32 {
+                    let step = UVec3::new(corner & 1, 0, corner >> 1);
+                    let c = (base + step).min(problem.cells - 1).with_y(0);
+                    let w = corner_weight(step, f.with_y(0.0));
+                    sum += w * problem.bottom_irradiance(solution, c);
+                }
+                [sum, Vec3::ZERO]
+            })[0]
+        })
     }
 
-    /// `I0`, the current over it and the droplets' mean cosine at `p` (clamped into the finest
-    /// cascade holding it, so that points below the grid read its bottom cells), each cell
-    /// weighted by its optical thickness; None without a volume.
+    /// `I0`, the current over it and the droplets' mean cosine at `p` (clamped into each cascade,
+    /// so that points below the grid read its bottom cells; the cascades blended by
+    /// [`LightVolume::blend_cascades`]), each cell weighted by its optical thickness; None without
+    /// a volume.
     fn sample(&self, p: Vec3) -> Option<(Vec3, Vec3, f32)> {
         if !self.enabled {
             return None;
         }
-        let (problem, solution) = self.cascade_at(p);
+        let [radiance, current] = self.blend_cascades(p, |cascade| Self::sample_in(cascade, p));
+        let g = self.cascades[0].0.optics.mean_cosine;
+        Some((radiance, current, g))
+    }
+
+    /// `I0` and the current over it at `p` in one cascade.
+    fn sample_in((problem, solution): &(Diffusion, DiffuseField), p: Vec3) -> [Vec3; 2] {
         let (base, f) = interpolation_base(problem, p);
         let (mut radiance, mut current, mut weights) = (Vec3::ZERO, Vec3::ZERO, 0.0);
         for corner in 0..8u32 {
@@ -101,21 +109,54 @@ impl LightVolume {
             current += w * problem.relative_current(solution, c);
             weights += w;
         }
-        let g = problem.optics.mean_cosine;
-        Some((radiance / weights, current / weights, g))
+        [radiance / weights, current / weights]
     }
 
-    /// The finest cascade holding `p` within half a cell of its sides, else the coarsest.
-    fn cascade_at(&self, p: Vec3) -> &(Diffusion, DiffuseField) {
-        self.cascades
-            .iter()
-            .find(|(problem, _)| {
-                let n = problem.cells.as_vec3();
-                let local = (p - problem.cascade.min_m) / problem.cascade.cell_m;
-                local.x >= 0.5 && local.z >= 0.5 && local.x <= n.x - 0.5 && local.z <= n.z - 0.5
-            })
-            .unwrap_or_else(|| self.cascades.last().expect("at least one cascade"))
+    /// `read`'s values at `p` from the cascades, finest first: each cascade's weighted by
+    /// [`cascade_weight`] of what the finer ones left, the coarsest taking the rest, so that the
+    /// light passes from a cascade to the next over [`CASCADE_BLEND_CELLS`] rather than at a seam
+    /// (`environment_light_volume_blend`).
+    fn blend_cascades(
+        &self,
+        p: Vec3,
+        read: impl Fn(&(Diffusion, DiffuseField)) -> [Vec3; 2],
+    ) -> [Vec3; 2] {
+        let (mut sum, mut left) = ([Vec3::ZERO; 2], 1.0);
+        for (k, cascade) in self.cascades.iter().enumerate() {
+            let last = k + 1 == self.cascades.len();
+            let w = if last {
+                1.0
+            } else {
+                cascade_weight(&cascade.0, p)
+            };
+            if w > 0.0 {
+                let values = read(cascade);
+                for (s, v) in sum.iter_mut().zip(values) {
+                    *s += left * w * v;
+                }
+                left *= 1.0 - w;
+            }
+            if left <= 0.0 {
+                break;
+            }
+        }
+        sum
     }
+}
+
+/// Cells of a cascade, inward from its sides, over which the next coarser one hands over to it.
+pub const CASCADE_BLEND_CELLS: f32 = 4.0;
+
+/// How much a cascade's own value counts at `p`: 1 from [`CASCADE_BLEND_CELLS`] inside its sides
+/// (measured from its outermost cells' centres) inward, falling linearly to 0 at them.
+fn cascade_weight(problem: &Diffusion, p: Vec3) -> f32 {
+    let n = problem.cells.as_vec3();
+    let local = (p - problem.cascade.min_m) / problem.cascade.cell_m;
+    let inside = (local.x - 0.5)
+        .min(local.z - 0.5)
+        .min(n.x - 0.5 - local.x)
+        .min(n.z - 0.5 - local.z);
+    (inside / CASCADE_BLEND_CELLS).clamp(0.0, 1.0)
 }
 
 /// The cell below and behind `p` in `problem`'s grid (`p` clamped to the cells' centres) and the

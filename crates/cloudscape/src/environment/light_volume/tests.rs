@@ -220,3 +220,40 @@ fn the_ground_sees_the_sky_in_clear_air_and_less_under_a_cloud() {
         "under the cloud {shaded}, in clear air {open}"
     );
 }
+
+/// A fine cascade hands over to the coarse one around it over `CASCADE_BLEND_CELLS` of its cells,
+/// not at a seam: walking out across the fine cascade's side in steps of an eighth of a cell, the
+/// diffuse light goes from the fine cascade's value to the coarse one's without a jump.
+#[test]
+fn the_cascades_blend_without_a_seam() {
+    use super::read::{CASCADE_BLEND_CELLS, LightVolume};
+    let (fine, _) = blob();
+    let mut coarse = fine.clone();
+    coarse.cascade.cell_m *= 2.0;
+    coarse.cascade.min_m -= 0.5 * coarse.cells.as_vec3() * fine.cascade.cell_m;
+    let filled = |problem: &Diffusion, value: f32| {
+        let mut field = problem.cold_field();
+        field.radiance.iter_mut().for_each(|r| *r = Vec3::splat(value));
+        field
+    };
+    let (fine_field, coarse_field) = (filled(&fine, 1.0), filled(&coarse, 3.0));
+    let cell_m = fine.cascade.cell_m.x;
+    let (min_m, size_m) = (fine.cascade.min_m, fine.cells.as_vec3() * fine.cascade.cell_m);
+    let volume = LightVolume {
+        cascades: vec![(fine, fine_field), (coarse, coarse_field)],
+        enabled: true,
+    };
+    let centre = min_m + 0.5 * size_m;
+    let light = |x: f32| {
+        let p = Vec3::new(x, centre.y, centre.z);
+        volume.diffuse(p, Vec3::Y).x
+    };
+    let (inside, outside) = (centre.x, min_m.x + size_m.x + 2.0 * cell_m);
+    let steps: Vec<f32> = (0..=((outside - inside) / cell_m * 8.0) as u32)
+        .map(|k| light(inside + k as f32 * cell_m / 8.0))
+        .collect();
+    let largest = steps.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f32::max);
+    assert!((steps[0] - 1.0).abs() < 1e-4 && (steps[steps.len() - 1] - 3.0).abs() < 1e-4);
+    let smooth = 2.0 / (8.0 * CASCADE_BLEND_CELLS);
+    assert!(largest <= 1.01 * smooth, "largest step {largest}, a linear hand-over {smooth}");
+}
