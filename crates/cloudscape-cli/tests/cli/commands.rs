@@ -201,7 +201,11 @@ fn bench_json_reports_each_pass_and_the_frame_wall_time() {
                 "display",
             ],
             (Some(true), _) => &[
+                "light volume cells",
+                "light volume solve",
+                "light volume table",
                 "particles: generate",
+                "particles: occlusion",
                 "particles: bin",
                 "particles: render",
                 "upsample",
@@ -212,7 +216,7 @@ fn bench_json_reports_each_pass_and_the_frame_wall_time() {
         };
         // Every technique's frame starts with the environment's passes: the shadow map, the sky's
         // static tables (in the first frame: no warm-up here) and its per-frame ones (then the
-        // light volume's, for the ray marcher, which reads it).
+        // light volume's, for the ray marcher and the particles, which read it).
         let environment = [
             "cloud shadow map",
             "sky: transmittance table",

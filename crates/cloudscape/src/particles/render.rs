@@ -36,13 +36,16 @@ pub const TILE_CAPACITY: u32 = 16384;
 /// Bytes of all tile lists at most.
 pub const TILE_LIST_BYTES: u64 = 96 << 20;
 
+/// The timed pass that makes the particles from the field.
+const GENERATE_PASS: &str = "particles: generate";
+/// The timed pass of the seed's tiled light occlusion.
+const OCCLUSION_PASS: &str = "particles: occlusion";
+/// The timed pass that bins the particles into screen tiles.
+const BIN_PASS: &str = "particles: bin";
+/// The timed pass that sorts and blends each screen tile.
+const RENDER_PASS: &str = "particles: render";
 /// The timed passes of a frame, in order.
-pub const PASS_NAMES: &[&str] = &[
-    "particles: generate",
-    "particles: bin",
-    "particles: render",
-    "particles: occlusion",
-];
+pub const PASS_NAMES: &[&str] = &[GENERATE_PASS, OCCLUSION_PASS, BIN_PASS, RENDER_PASS];
 
 /// The `Render` uniform of `particle_render.wgsl`.
 #[repr(C)]
@@ -305,7 +308,7 @@ impl ParticleRenderer {
         let occlusion = self.occlusion.as_mut().expect("made above");
         let generator = self.generator.as_ref().expect("made before encoding");
         let tables = self.tables.as_ref().expect("configure loads the tables");
-        let writes = timer.and_then(|t| t.compute_pass_writes(PASS_NAMES[3]));
+        let writes = timer.and_then(|t| t.compute_pass_writes(OCCLUSION_PASS));
         occlusion.encode(ctx, encoder, (g, generator, tables), writes);
     }
 
@@ -322,7 +325,7 @@ impl ParticleRenderer {
             let generator = self.generator.as_ref().expect("made before encoding");
             let writes = timer
                 .as_deref_mut()
-                .and_then(|t| t.compute_pass_writes(PASS_NAMES[0]));
+                .and_then(|t| t.compute_pass_writes(GENERATE_PASS));
             generator.encode(encoder, shared, writes);
             let g = self.generation.expect("prepare comes before encoding");
             self.encode_occlusion(ctx, encoder, &g, timer.as_deref_mut());
@@ -330,9 +333,9 @@ impl ParticleRenderer {
         let generator = self.generator.as_ref().expect("made before encoding");
         let lists = self.lists.as_ref().expect("made before encoding");
         encoder.clear_buffer(&lists.counts, 0, None);
-        let writes = timer.and_then(|t| t.compute_pass_writes(PASS_NAMES[1]));
+        let writes = timer.and_then(|t| t.compute_pass_writes(BIN_PASS));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(PASS_NAMES[1]),
+            label: Some(BIN_PASS),
             timestamp_writes: writes,
         });
         set_groups(&mut pass, &shared.bind_groups(self.pass.slots, group));
@@ -431,9 +434,9 @@ impl Technique for ParticleRenderer {
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.settings));
         let tiles_x = lists.tiles.x;
         let group = self.bind_group(ctx, targets);
-        let writes = timer.and_then(|(t, _)| t.compute_pass_writes(PASS_NAMES[2]));
+        let writes = timer.and_then(|(t, _)| t.compute_pass_writes(RENDER_PASS));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(PASS_NAMES[2]),
+            label: Some(RENDER_PASS),
             timestamp_writes: writes,
         });
         set_groups(&mut pass, &shared.bind_groups(self.pass.slots, &group));

@@ -233,12 +233,18 @@ fn the_cascades_blend_without_a_seam() {
     coarse.cascade.min_m -= 0.5 * coarse.cells.as_vec3() * fine.cascade.cell_m;
     let filled = |problem: &Diffusion, value: f32| {
         let mut field = problem.cold_field();
-        field.radiance.iter_mut().for_each(|r| *r = Vec3::splat(value));
+        field
+            .radiance
+            .iter_mut()
+            .for_each(|r| *r = Vec3::splat(value));
         field
     };
     let (fine_field, coarse_field) = (filled(&fine, 1.0), filled(&coarse, 3.0));
     let cell_m = fine.cascade.cell_m.x;
-    let (min_m, size_m) = (fine.cascade.min_m, fine.cells.as_vec3() * fine.cascade.cell_m);
+    let (min_m, size_m) = (
+        fine.cascade.min_m,
+        fine.cells.as_vec3() * fine.cascade.cell_m,
+    );
     let volume = LightVolume {
         cascades: vec![(fine, fine_field), (coarse, coarse_field)],
         enabled: true,
@@ -252,8 +258,14 @@ fn the_cascades_blend_without_a_seam() {
     let steps: Vec<f32> = (0..=((outside - inside) / cell_m * 8.0) as u32)
         .map(|k| light(inside + k as f32 * cell_m / 8.0))
         .collect();
-    let largest = steps.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f32::max);
+    let largest = steps
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(0.0, f32::max);
     assert!((steps[0] - 1.0).abs() < 1e-4 && (steps[steps.len() - 1] - 3.0).abs() < 1e-4);
     let smooth = 2.0 / (8.0 * CASCADE_BLEND_CELLS);
-    assert!(largest <= 1.01 * smooth, "largest step {largest}, a linear hand-over {smooth}");
+    assert!(
+        largest <= 1.01 * smooth,
+        "largest step {largest}, a linear hand-over {smooth}"
+    );
 }
