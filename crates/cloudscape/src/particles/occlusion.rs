@@ -25,9 +25,10 @@ use glam::{IVec2, Vec3};
 
 use super::generate::{Generation, OCCLUSION_MAX_DEPTH, Particle};
 use super::optical_depth::{ChordProfile, unit_sphere_chord};
+
 /// Particles of a tile that are sorted and walked, at most (the screen tiles' sort serves both): a
 /// tile that lists more keeps the nearest the sun, which hide the rest.
-use super::render::TILE_SORTED as LIGHT_TILE_SORTED;
+pub const LIGHT_TILE_SORTED: u32 = super::render::TILE_SORTED;
 
 /// Side of a light tile, in cells of its level's ring: more than the largest particle radius
 /// ([`super::generate::RADIUS_PER_CELL`] cells), so the 3x3 tiles around a ray hold every
@@ -230,7 +231,7 @@ struct Walker {
 }
 
 /// The walk so far: optical depth and list entries walked.
-type Progress = (f32, u32);
+pub type Progress = (f32, u32);
 
 /// Walks one tile's sorted list up to the walker's place: every entry of a smaller depth level,
 /// and of its own level those nearer the sun (by exact distance, so that the walk does not
@@ -238,14 +239,14 @@ type Progress = (f32, u32);
 fn walk_list(
     particles: &[Particle],
     list: &[u32],
-    (walk, level, me): (&Walk, u32, &Walker),
+    (with, level, me): (&Walk, u32, &Walker),
     (mut tau, mut walked): Progress,
 ) -> Progress {
-    let tiles = walk.tiles;
+    let tiles = with.tiles;
     let own_level = tiles.depth_level(me.centre_m, level);
     for &key in list {
         let depth_level = key >> INDEX_BITS;
-        if depth_level > own_level || (walk.early_exit && tau > OCCLUSION_MAX_DEPTH) {
+        if depth_level > own_level || (with.early_exit && tau > OCCLUSION_MAX_DEPTH) {
             break;
         }
         let occluder = &particles[(key & ((1 << INDEX_BITS) - 1)) as usize];
@@ -253,7 +254,7 @@ fn walk_list(
             continue;
         }
         let ray = (me.centre_m, me.start_m);
-        tau += occluder_optical_depth(occluder, ray, tiles.sun, walk.sigma_max_per_m, walk.chord);
+        tau += occluder_optical_depth(occluder, ray, tiles.sun, with.sigma_max_per_m, with.chord);
         walked += 1;
     }
     (tau, walked)
@@ -261,9 +262,14 @@ fn walk_list(
 
 /// The optical depth toward the sun of particle `index` (the walk of the lists of the 3x3 tiles
 /// around its ray on its level and the levels next to it), and the list entries it walked.
-pub fn walk(particles: &[Particle], lists: &[Vec<u32>], walk: &Walk, index: u32) -> (f32, u32) {
+pub fn walk_to_sun(
+    particles: &[Particle],
+    lists: &[Vec<u32>],
+    with: &Walk,
+    index: u32,
+) -> Progress {
     let p = &particles[index as usize];
-    let tiles = walk.tiles;
+    let tiles = with.tiles;
     let me = Walker {
         centre_m: p.centre_m,
         start_m: own_extent_toward(p, tiles.sun),
@@ -278,7 +284,7 @@ pub fn walk(particles: &[Particle], lists: &[Vec<u32>], walk: &Walk, index: u32)
                 progress = walk_list(
                     particles,
                     &lists[tile as usize],
-                    (walk, level, &me),
+                    (with, level, &me),
                     progress,
                 );
             }
@@ -288,12 +294,12 @@ pub fn walk(particles: &[Particle], lists: &[Vec<u32>], walk: &Walk, index: u32)
 }
 
 /// Sets every particle's `sun_optical_depth` by the walk, and returns the entries walked.
-pub fn occlude(particles: &mut [Particle], walk_with: &Walk) -> u64 {
+pub fn occlude(particles: &mut [Particle], with: &Walk) -> u64 {
     use rayon::prelude::*;
-    let lists = light_tile_lists(particles, walk_with.tiles);
-    let walks: Vec<(f32, u32)> = (0..particles.len() as u32)
+    let lists = light_tile_lists(particles, with.tiles);
+    let walks: Vec<Progress> = (0..particles.len() as u32)
         .into_par_iter()
-        .map(|i| walk(particles, &lists, walk_with, i))
+        .map(|i| walk_to_sun(particles, &lists, with, i))
         .collect();
     for (p, (tau, _)) in particles.iter_mut().zip(&walks) {
         p.sun_optical_depth = *tau;

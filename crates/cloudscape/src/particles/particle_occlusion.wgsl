@@ -178,7 +178,7 @@ fn walk_list(w_in: LightWalk, tile: i32, me: Walker) -> LightWalk {
     return w;
 }
 
-// occlusion::walk.
+// occlusion::walk_to_sun.
 @compute @workgroup_size(64)
 fn walk_light_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= particles_made() {
