@@ -46,6 +46,13 @@ const INDEX_BITS: u32 = 20;
 /// Levels of the quantised distance from the sun in a key's other 12 bits.
 const DEPTH_LEVELS: f32 = 4095.0;
 
+/// Most tiles along a level's side (even) for which `levels` levels of lists of
+/// [`MIN_LIGHT_TILE_CAPACITY`] entries fit in [`LIGHT_LIST_BYTES`].
+fn max_tiles_per_side(levels: u32) -> u32 {
+    let tiles = LIGHT_LIST_BYTES / (4 * u64::from(MIN_LIGHT_TILE_CAPACITY) * u64::from(levels));
+    ((tiles as f64).sqrt() as u32) & !1
+}
+
 /// The light-space tile grid of a frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightTiles {
@@ -77,12 +84,15 @@ impl LightTiles {
             .max((bottom - g.camera_m.y).abs());
         let sun = g.sun_direction.normalize();
         let right = sun.any_orthonormal_vector();
-        let tile_m = LIGHT_TILE_CELLS * g.grid.inner_cell_m;
         // A ring's square, seen along any sun, lies within its half-diagonal of the camera's
         // ray; the band's height adds to that; one more tile each side for the jitter.
         let half_diagonal_m =
             0.5 * std::f32::consts::SQRT_2 * g.grid.ring_cells as f32 * g.grid.inner_cell_m;
         let half_m = half_diagonal_m + vertical_reach_m;
+        // Wider tiles where that many would not fit the lists' memory (a band much taller than
+        // the cells are wide).
+        let max_half_tiles = (max_tiles_per_side(g.grid.rings) / 2 - 1) as f32;
+        let tile_m = (LIGHT_TILE_CELLS * g.grid.inner_cell_m).max(half_m / max_half_tiles);
         LightTiles {
             origin_m: g.camera_m,
             right,
@@ -305,4 +315,44 @@ pub fn occlude(particles: &mut [Particle], with: &Walk) -> u64 {
         p.sun_optical_depth = *tau;
     }
     walks.iter().map(|&(_, n)| u64::from(n)).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::SceneDocument;
+
+    /// Whatever the grid and the band, the light tiles' lists fit in their memory, at least
+    /// [`MIN_LIGHT_TILE_CAPACITY`] entries a tile, and cover every ring's particles.
+    #[test]
+    fn the_light_tiles_fit_their_memory_for_any_grid() {
+        for (rings, ring_cells, distance_m, thickness_m) in [
+            (5, 136, 200_000.0, 2200.0),
+            (8, 512, 1000.0, 10_000.0),
+            (1, 16, 1000.0, 10_000.0),
+            (8, 512, 1.0e6, 300.0),
+        ] {
+            let overrides = [
+                format!("particles.rings={rings}"),
+                format!("particles.ring_cells={ring_cells}"),
+                format!("particles.distance_m={distance_m}"),
+                format!("layers.0.thickness_m={thickness_m}"),
+            ];
+            let scene = SceneDocument::load(None, &overrides).expect("valid").scene;
+            let tiles = LightTiles::new(&Generation::from_scene(&scene, 0.2));
+            let bytes = 4 * u64::from(tiles.tile_count()) * u64::from(tiles.tile_capacity());
+            assert!(bytes <= LIGHT_LIST_BYTES, "{tiles:?}: {bytes} bytes");
+            assert!(tiles.tile_capacity() >= MIN_LIGHT_TILE_CAPACITY);
+            let ring_half_m = 0.5 * ring_cells as f32 * scene_cell_m(&scene);
+            let level_half_m = 0.5 * tiles.tiles_per_side as f32 * tiles.tile_m;
+            assert!(
+                level_half_m >= std::f32::consts::SQRT_2 * ring_half_m,
+                "{tiles:?}"
+            );
+        }
+    }
+
+    fn scene_cell_m(scene: &crate::scene::Scene) -> f32 {
+        crate::particles::grid::RingGrid::from_scene(scene).inner_cell_m
+    }
 }
