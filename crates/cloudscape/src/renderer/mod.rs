@@ -293,6 +293,7 @@ pub static PROGRAMS: &[&crate::shader::WgslModule] = &[
     &crate::probe::PROBE_WGSL,
     &crate::particles::gpu::PARTICLE_BAKE_WGSL,
     &crate::particles::generate_gpu::PARTICLE_GENERATE_WGSL,
+    &crate::particles::occlusion_gpu::PARTICLE_OCCLUSION_WGSL,
     &crate::particles::render::PARTICLE_RENDER_WGSL,
     &crate::sprites::render::SPRITE_RENDER_WGSL,
     &crate::sprites::render::SPRITE_IMPOSTOR_WGSL,
