@@ -101,6 +101,26 @@ fn small_grid_scene(overrides: &[&str]) -> Scene {
     SceneDocument::load(None, &all).expect("valid").scene
 }
 
+/// One frame of `scene`'s particles made on the GPU: the harness, the frame, the particles and
+/// their counts.
+fn generated_on_gpu(
+    ctx: &GpuContext,
+    scene: &Scene,
+) -> (Harness, Frame, Vec<Particle>, GenerationCounts) {
+    let mut harness = Harness::new(ctx, scene);
+    let frame = Frame::from_scene(scene, UVec2::new(96, 64));
+    harness.render(ctx, scene, &frame);
+    let (particles, counts) = harness.generated(ctx);
+    (harness, frame, particles, counts)
+}
+
+/// The scene's table spec and its reference particle's mean density.
+fn reference_particle(scene: &Scene) -> (ParticleTableSpec, f32) {
+    let spec = ParticleTableSpec::from_scene(scene);
+    let mean = RadialProfile::of(&spec.particle).volume_mean();
+    (spec, mean)
+}
+
 fn cpu_generation(scene: &Scene, field_mean: f32, early_exit: bool) -> Generation {
     Generation {
         occlusion_early_exit: early_exit,
@@ -126,12 +146,8 @@ fn gpu_particles_match_their_cpu_specification() {
         "render.time_s=90",
         "particles.occlusion=march",
     ]);
-    let mut harness = Harness::new(&ctx, &scene);
-    let frame = Frame::from_scene(&scene, UVec2::new(96, 64));
-    harness.render(&ctx, &scene, &frame);
-    let (gpu, counts) = harness.generated(&ctx);
-    let spec = ParticleTableSpec::from_scene(&scene);
-    let mean = RadialProfile::of(&spec.particle).volume_mean();
+    let (mut harness, _, gpu, counts) = generated_on_gpu(&ctx, &scene);
+    let (_, mean) = reference_particle(&scene);
     let cpu = generate::generate(harness.clouds.field(), &cpu_generation(&scene, mean, true));
     assert!(
         cpu.len() > 10_000,
@@ -213,10 +229,7 @@ fn tiled_light_occlusion_matches_its_cpu_specification() {
         "camera.position_m=[1234.5,1000,-777.7]",
         "sun.elevation_deg=35",
     ]);
-    let mut harness = Harness::new(&ctx, &scene);
-    let frame = Frame::from_scene(&scene, UVec2::new(96, 64));
-    harness.render(&ctx, &scene, &frame);
-    let (gpu, counts) = harness.generated(&ctx);
+    let (harness, frame, gpu, counts) = generated_on_gpu(&ctx, &scene);
     let tiles_counted = harness
         .particles
         .light_occlusion()
@@ -227,8 +240,7 @@ fn tiled_light_occlusion_matches_its_cpu_specification() {
         LightTileCounts::default(),
         "no tile overflowed, none outside"
     );
-    let spec = ParticleTableSpec::from_scene(&scene);
-    let mean = RadialProfile::of(&spec.particle).volume_mean();
+    let (spec, mean) = reference_particle(&scene);
     let g = Generation::from_scene(&scene, mean).for_frame(&frame);
     let tiles = LightTiles::new(&g);
     let chord = ChordProfile::of_particle(&spec.particle);
