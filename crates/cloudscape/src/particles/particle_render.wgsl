@@ -235,8 +235,9 @@ fn particle_segment(p: Particle, o: vec3<f32>, d: vec3<f32>, t_max: f32, light: 
     if render.diffuse_from_volume == 1u && environment_has_light_volume() {
         let middle = o + d * (0.5 * (near_m + far_m));
         let diffuse = environment_light_volume_diffuse(middle, -d);
-        let sun_in = normalize(environment_sun_direction() / radii);
-        let own_tau = 0.5 * render.sigma_max_per_m * p.density * chord_mass(-sun_in, sun_in) / length(environment_sun_direction() / radii);
+        // Half the particle's own chord toward the sun, through its centre (the unit sphere's
+        // chord along to_light, scaled back to metres).
+        let own_tau = 0.5 * render.sigma_max_per_m * p.density * chord_mass(-to_light, to_light) / length(environment_sun_direction() / radii);
         let slab = SlabModel(render.phase_lobes, render.slab_params);
         let peak = light.sun * slab_peak_beam(slab, dot(d, environment_sun_direction()), p.sun_optical_depth + own_tau);
         return BlendSegment(near_m, far_m, optical_depth, single_sun + peak + render.albedo * diffuse);
