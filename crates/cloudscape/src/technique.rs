@@ -62,6 +62,9 @@ pub struct FrameInputs<'a> {
     pub environment: &'a Environment,
     /// The rays the output holds.
     pub grid: &'a SampleGrid,
+    /// The shared GPU groups as this frame set them (the field at the frame's time), for work
+    /// whose result the CPU needs before encoding (reading the field at many points).
+    pub shared: Shared<'a>,
 }
 
 /// Where a technique reads and writes.

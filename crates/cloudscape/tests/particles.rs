@@ -61,6 +61,7 @@ impl Harness {
             frame,
             environment: self.clouds.environment(),
             grid: &SampleGrid::FULL,
+            shared: self.clouds.shared(),
         };
         self.particles.prepare(ctx, &inputs);
         let targets = TechniqueTargets {

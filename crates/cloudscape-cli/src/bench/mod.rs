@@ -93,6 +93,12 @@ struct Report {
     software: bool,
     passes: Vec<Stat>,
     frame_wall: Stat,
+    /// CPU time of the technique's per-frame preparation (sorting, building what it makes on the
+    /// CPU, reading back what it asked the GPU).
+    prepare_cpu: Stat,
+    /// The first frame's preparation, ms: everything the technique builds on the CPU for a scene
+    /// (the sprites' clouds).
+    first_prepare_cpu_ms: f64,
     /// Extinction evaluations along view rays per pixel (the last frame; for particles,
     /// particle segments blended per pixel; for sprites, layers of sprites per pixel).
     density_samples_per_pixel: f64,
@@ -165,14 +171,19 @@ fn time_frames(args: &BenchArgs, ctx: &GpuContext, extra: &[String]) -> Result<R
     let names = renderer.pass_names();
     let reuse = args.temporal.map_or(Reuse::None, temporal_reuse);
     let mut pass_ms: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
-    let mut wall_ms = Vec::new();
+    let (mut wall_ms, mut prepare_ms, mut first_prepare_cpu_ms) = (Vec::new(), Vec::new(), 0.0);
     for i in 0..args.warmup + frames {
         frame.frame_index = i;
         let wall = renderer.render_frame(ctx, &frame, reuse, &mut timer);
+        let prepare = renderer.clouds().prepare_time().as_secs_f64() * 1e3;
+        if i == 0 {
+            first_prepare_cpu_ms = prepare;
+        }
         if i < args.warmup {
             continue;
         }
         wall_ms.push(wall.as_secs_f64() * 1e3);
+        prepare_ms.push(prepare);
         for (label, ms) in timer.read_ms(ctx) {
             if let Some(k) = names.iter().position(|p| *p == label) {
                 pass_ms[k].push(ms);
@@ -200,6 +211,8 @@ fn time_frames(args: &BenchArgs, ctx: &GpuContext, extra: &[String]) -> Result<R
             .map(|(n, s)| Stat::new(n, s))
             .collect(),
         frame_wall: Stat::new("frame (wall)", wall_ms),
+        prepare_cpu: Stat::new("prepare (CPU)", prepare_ms),
+        first_prepare_cpu_ms,
         density_samples_per_pixel: stats.map_or(0.0, |s| s.density_samples_per_pixel),
         primitives: stats.and_then(|s| s.primitives),
     })
@@ -226,12 +239,20 @@ fn print_report(report: &Report) {
         "{:<22} {:>10} {:>10} {:>10}",
         "pass", "mean ms", "median ms", "min ms"
     );
-    for s in report.passes.iter().chain([&report.frame_wall]) {
+    for s in report
+        .passes
+        .iter()
+        .chain([&report.frame_wall, &report.prepare_cpu])
+    {
         println!(
             "{:<22} {:>10.3} {:>10.3} {:>10.3}",
             s.name, s.mean_ms, s.median_ms, s.min_ms
         );
     }
+    println!(
+        "first frame's prepare (CPU): {:.1} ms (what the technique builds on the CPU for the scene)",
+        report.first_prepare_cpu_ms
+    );
     let samples = report.density_samples_per_pixel;
     match report.primitives {
         Some(n) => println!("primitives drawn: {n}; blended per pixel: {samples:.1}"),

@@ -10,6 +10,8 @@ pub mod hiheight;
 mod layer;
 pub mod noise;
 pub mod profile;
+pub mod read_gpu;
+mod reader;
 pub(crate) mod texture;
 mod vol_file;
 pub mod voxel;
@@ -17,6 +19,7 @@ pub mod weather;
 
 pub use layer::LayerField;
 pub use noise::NoiseKind;
+pub use reader::{CoarseFieldReader, CpuCoarseReader};
 pub use texture::Texture8;
 pub use voxel::VoxelGrid;
 pub use weather::Weather;

@@ -127,6 +127,8 @@ pub struct CloudRenderer {
     environment: (Environment, bool),
     /// Whether the technique's once-a-frame passes still need recording this frame.
     technique_setup_pending: bool,
+    /// CPU time the technique took to take the last frame begun ([`Technique::prepare`]).
+    prepare_time: std::time::Duration,
     technique: Box<dyn Technique>,
     temporal: Option<TemporalResolve>,
     upsampler: Upsampler,
@@ -180,6 +182,7 @@ impl CloudRenderer {
             environment_passes,
             environment: (Environment::from_scene(scene), false),
             technique_setup_pending: false,
+            prepare_time: std::time::Duration::ZERO,
             technique,
             temporal: None,
             upsampler,
@@ -367,11 +370,24 @@ impl CloudRenderer {
             frame,
             environment: &env,
             grid: &grid,
+            shared: Shared {
+                field: &self.field_gpu,
+                frame: &self.frame_gpu,
+                environment: &self.environment_gpu,
+            },
         };
+        let start = std::time::Instant::now();
         self.technique.prepare(ctx, &inputs);
+        self.prepare_time = start.elapsed();
         self.technique_setup_pending = true;
         self.frame = Some(frame.clone());
         self.reuse = reuse;
+    }
+
+    /// The CPU time the technique took to take the last frame begun: what it builds or sorts on
+    /// the CPU (the sprites' clouds and their order), and what it waits for the GPU to read back.
+    pub fn prepare_time(&self) -> std::time::Duration {
+        self.prepare_time
     }
 
     /// The shadow map this frame reads: the one built before, when [`ShadowReuse`] allows it,

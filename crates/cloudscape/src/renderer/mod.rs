@@ -281,6 +281,7 @@ pub fn read_back(ctx: &GpuContext, images: &FrameImages) -> Rendered {
 /// tests: every `.wgsl` file of the crate is reached from one of them.
 pub static PROGRAMS: &[&crate::shader::WgslModule] = &[
     &crate::field::gpu::NOISE_GEN_WGSL,
+    &crate::field::read_gpu::FIELD_READ_WGSL,
     &crate::environment::ATMOSPHERE_LUTS_WGSL,
     &crate::environment::ATMOSPHERE_AERIAL_WGSL,
     &crate::environment::CLOUD_SHADOW_WGSL,

@@ -9,19 +9,14 @@ use std::path::Path;
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
 
-use super::from_field::{FieldTiling, TileKey};
+use super::from_field::{FieldTiling, TileDraft, TileKey};
 use super::model::SpriteCloud;
 use super::shading::{self, ColorLevel, LEVELS, SunLight, physical_levels};
 use super::{CloudModel, ModelFile};
-use crate::field::{CloudField, FieldError};
+use crate::field::{CloudField, CoarseFieldReader, CpuCoarseReader, FieldError};
 use crate::optics::PhaseLobes;
 use crate::particles::DEFAULT_EXTINCTION_PER_M;
 use crate::scene::{Scene, SpriteCloudSpec, SpriteLod};
-
-/// Tiles to make at once above which the base noise is baked first. Measured on 2 cores: the
-/// default scene's 2,200 tiles take 5 s read on demand, and the bake alone about as long; the
-/// 11,300 tiles of a 10,000-cloud overcast take 12 s baked (690 s on demand, under load).
-const BAKE_ABOVE_TILES: usize = 4000;
 
 /// `layer` of a sprite no wind carries.
 pub const NO_LAYER: u32 = 4;
@@ -82,26 +77,27 @@ impl GpuCloud {
     }
 }
 
-/// A cloud with where it came from: the field (its layer's extinction) or an artist (levels given
-/// or derived).
-#[derive(Clone, Debug)]
-struct Placed {
-    cloud: SpriteCloud,
-    levels: Option<[ColorLevel; LEVELS]>,
-    from_field: bool,
-}
+/// A cloud to lay out: the cloud, its colour levels (None: derived) and whether the field made it.
+type Laid<'a> = (&'a SpriteCloud, Option<[ColorLevel; LEVELS]>, bool);
 
 /// The scene's sprite clouds and their GPU records.
 pub struct CloudSet {
-    authored: Vec<Placed>,
+    authored: Vec<Authored>,
     tiling: Option<FieldTiling>,
+    /// Each tile's draft (its candidates), kept while the camera stays near and through edits
+    /// that change only the field's density (coverage).
+    drafts: BTreeMap<TileKey, Option<TileDraft>>,
+    /// Each tile's cloud at the field's current density.
     tiles: BTreeMap<TileKey, Option<SpriteCloud>>,
     scene_key: String,
+    draft_key: String,
     /// The light of the configured scene, toward the sun the groups were last lit by.
     light: SunLight,
     /// Extinction of clouds of no layer (hand-made), m^-1: the densest layer's.
     default_extinction_per_m: f32,
     lod: SpriteLod,
+    /// Whether field clouds are lit on the GPU from the light volume (no group light here).
+    lit_by_volume: bool,
     /// The sprites, cloud by cloud.
     pub sprites: Vec<GpuSprite>,
     /// The clouds.
@@ -118,11 +114,14 @@ impl Default for CloudSet {
         CloudSet {
             authored: Vec::new(),
             tiling: None,
+            drafts: BTreeMap::new(),
             tiles: BTreeMap::new(),
             scene_key: String::new(),
+            draft_key: String::new(),
             light: SunLight::default(),
             default_extinction_per_m: DEFAULT_EXTINCTION_PER_M,
             lod: SpriteLod::Clusters,
+            lit_by_volume: false,
             sprites: Vec::new(),
             clouds: Vec::new(),
             cloud_centres: Vec::new(),
@@ -141,18 +140,17 @@ impl CloudSet {
             return;
         }
         self.scene_key = key;
-        self.authored = authored
-            .iter()
-            .map(|(cloud, levels)| Placed {
-                cloud: cloud.clone(),
-                levels: *levels,
-                from_field: false,
-            })
-            .collect();
+        let draft_key = draft_key(scene);
+        if draft_key != self.draft_key {
+            self.draft_key = draft_key;
+            self.drafts.clear();
+        }
+        self.authored = authored.to_vec();
         self.tiles.clear();
         self.sprites.clear();
         self.clouds.clear();
         self.lod = scene.sprites.lod;
+        self.lit_by_volume = scene.lighting.model == crate::scene::LightingModel::Volume;
         self.tiling = scene.sprites.field_clouds.then_some(FieldTiling {
             tile_m: scene.sprites.cloud_size_m,
             distance_m: scene.sprites.distance_m,
@@ -168,31 +166,46 @@ impl CloudSet {
             .unwrap_or(DEFAULT_EXTINCTION_PER_M);
     }
 
-    /// Brings the set to this frame: makes the field clouds of tiles the camera reached, forgets
-    /// those it left, and relights the groups when the sun turned. Returns whether the records
-    /// changed.
-    pub fn update(&mut self, field: &CloudField, camera_m: Vec3, sun: Vec3, time_s: f32) -> bool {
+    /// Brings the set to this frame: makes the field clouds of tiles the camera reached (their
+    /// candidates' densities read by `reader`, at `time_s`), forgets those it left, and relights
+    /// the groups when the sun turned. Returns whether the records changed.
+    pub fn update(
+        &mut self,
+        field: &CloudField,
+        reader: &dyn CoarseFieldReader,
+        (camera_m, sun): (Vec3, Vec3),
+        time_s: f32,
+    ) -> bool {
         let mut changed = self.sprites.is_empty() && self.clouds.is_empty();
         if let Some(tiling) = self.tiling.as_mut() {
             tiling.time_s = time_s;
             let wanted = tiling.tiles_around(field, camera_m);
-            let missing: Vec<TileKey> = wanted
-                .iter()
-                .filter(|k| !self.tiles.contains_key(k))
-                .copied()
-                .collect();
-            let keep: std::collections::BTreeSet<TileKey> = wanted.into_iter().collect();
+            let keep: std::collections::BTreeSet<TileKey> = wanted.iter().copied().collect();
             let before = self.tiles.len();
             self.tiles.retain(|k, _| keep.contains(k));
+            self.drafts.retain(|k, _| keep.contains(k));
+            let undrafted: Vec<TileKey> = wanted
+                .iter()
+                .filter(|k| !self.drafts.contains_key(k))
+                .copied()
+                .collect();
+            let drafted: Vec<Option<TileDraft>> = {
+                use rayon::prelude::*;
+                undrafted
+                    .par_iter()
+                    .map(|&k| tiling.draft(field, k))
+                    .collect()
+            };
+            self.drafts.extend(undrafted.into_iter().zip(drafted));
+            let missing: Vec<TileKey> = wanted
+                .into_iter()
+                .filter(|k| !self.tiles.contains_key(k))
+                .collect();
             changed |= self.tiles.len() != before || !missing.is_empty();
-            if missing.len() > BAKE_ABOVE_TILES {
-                field.bake_coarse_noise();
-            }
-            let made = tiling.clouds(field, &missing);
-            let mut made: BTreeMap<TileKey, SpriteCloud> = made.into_iter().collect();
-            for k in missing {
-                self.tiles.insert(k, made.remove(&k));
-            }
+            let drafts: Vec<Option<TileDraft>> =
+                missing.iter().map(|k| self.drafts[k].clone()).collect();
+            let made = tiling.finish(field, &drafts, reader);
+            self.tiles.extend(missing.into_iter().zip(made));
         }
         let lit = self.light.sun;
         let relight = lit.angle_between(sun) > SUN_TOLERANCE_RAD || lit == Vec3::ZERO;
@@ -207,35 +220,37 @@ impl CloudSet {
 
     /// Lays every cloud out again.
     fn rebuild(&mut self, field: &CloudField) {
-        let field_clouds = self.tiles.values().flatten().map(|cloud| Placed {
-            cloud: cloud.clone(),
-            levels: None,
-            from_field: true,
-        });
-        let all: Vec<Placed> = self.authored.iter().cloned().chain(field_clouds).collect();
-        self.sprites.clear();
-        self.clouds.clear();
-        self.cloud_centres.clear();
+        let authored = self
+            .authored
+            .iter()
+            .map(|(cloud, levels)| (cloud, *levels, false));
+        let from_field = self
+            .tiles
+            .values()
+            .flatten()
+            .map(|cloud| (cloud, None, true));
+        let all: Vec<Laid> = authored.chain(from_field).collect();
         let (light, default_extinction) = (self.light, self.default_extinction_per_m);
         let laid: Vec<(GpuCloud, Vec<GpuSprite>)> = {
             use rayon::prelude::*;
             all.par_iter()
-                .map(|p| {
-                    let extinction = p
-                        .cloud
+                .map(|&placed| {
+                    let extinction = placed
+                        .0
                         .layer
                         .and_then(|l| field.layers.get(l as usize))
                         .map_or(default_extinction, |l| l.extinction_per_m);
-                    self.lay_out(p, field, &light.with_extinction(extinction))
+                    self.lay_out(placed, field, &light.with_extinction(extinction))
                 })
                 .collect()
         };
+        self.sprites.clear();
+        self.clouds.clear();
+        self.cloud_centres.clear();
         for (index, (cloud, sprites)) in laid.into_iter().enumerate() {
-            let placed = &all[index];
-            self.cloud_centres.push((
-                placed.cloud.center_m,
-                placed.cloud.layer.unwrap_or(NO_LAYER),
-            ));
+            let placed = all[index].0;
+            self.cloud_centres
+                .push((placed.center_m, placed.layer.unwrap_or(NO_LAYER)));
             self.clouds.push(cloud);
             self.sprites.extend(sprites.into_iter().map(|mut s| {
                 s.cloud = index as u32;
@@ -247,20 +262,26 @@ impl CloudSet {
     /// One cloud's record and its sprites' (their `cloud` index set by the caller).
     fn lay_out(
         &self,
-        placed: &Placed,
+        (placed, levels, from_field): Laid,
         field: &CloudField,
         light: &SunLight,
     ) -> (GpuCloud, Vec<GpuSprite>) {
+        let billboard;
         let cloud = match self.lod {
-            SpriteLod::Clusters => placed.cloud.clone(),
-            SpriteLod::Billboards => placed.cloud.billboard(),
+            SpriteLod::Clusters => placed,
+            SpriteLod::Billboards => {
+                billboard = placed.billboard();
+                &billboard
+            }
         };
-        let (lo, hi) = placed.cloud.vertical_extent_m();
+        let (lo, hi) = placed.vertical_extent_m();
         let height = (hi - lo).max(1.0);
-        let levels = placed
-            .levels
-            .unwrap_or_else(|| physical_levels(height, light.extinction_per_m, light.g));
-        let lights = shading::group_lights(&cloud, placed.from_field.then_some(field), light);
+        let levels =
+            levels.unwrap_or_else(|| physical_levels(height, light.extinction_per_m, light.g));
+        let lights = match (from_field, self.lit_by_volume) {
+            (true, true) => vec![shading::GroupLight::default(); cloud.group_count() as usize],
+            (from_field, _) => shading::group_lights(cloud, from_field.then_some(field), light),
+        };
         let layer = cloud.layer.unwrap_or(NO_LAYER);
         let sprites = cloud
             .sprites
@@ -290,7 +311,7 @@ impl CloudSet {
     pub fn sprite_clouds(&self) -> Vec<SpriteCloud> {
         self.authored
             .iter()
-            .map(|p| p.cloud.clone())
+            .map(|(cloud, _)| cloud.clone())
             .chain(self.tiles.values().flatten().cloned())
             .collect()
     }
@@ -316,10 +337,11 @@ pub fn scene_clouds(
         };
         let camera = glam::Vec3::from_array(scene.camera.position_m);
         let keys = tiling.tiles_around(field, camera);
-        if keys.len() > BAKE_ABOVE_TILES {
-            field.bake_coarse_noise();
-        }
-        clouds.extend(tiling.clouds(field, &keys).into_iter().map(|(_, c)| c));
+        let reader = CpuCoarseReader {
+            field,
+            time_s: tiling.time_s,
+        };
+        clouds.extend(tiling.clouds(field, &keys, &reader).into_iter().flatten());
     }
     Ok(clouds)
 }
@@ -365,6 +387,29 @@ pub const MAX_SPRITE_OPTICAL_DEPTH: f32 = 3.0;
 fn sprite_optical_depth(light: &SunLight, width_m: f32) -> f32 {
     (light.extinction_per_m * shading::MEAN_RELATIVE_DENSITY * width_m)
         .min(MAX_SPRITE_OPTICAL_DEPTH)
+}
+
+/// What the tiles' drafts depend on: the scene's layers but for their coverage, the weather, the
+/// planet and the sprites' settings. An edit of coverage alone keeps every draft.
+fn draft_key(scene: &Scene) -> String {
+    let layers: Vec<_> = scene
+        .layers
+        .iter()
+        .map(|l| crate::scene::CloudLayer {
+            coverage: 0.0,
+            ..l.clone()
+        })
+        .collect();
+    format!(
+        "{:?}",
+        (
+            &layers,
+            &scene.weather,
+            &scene.noise,
+            &scene.planet,
+            &scene.sprites
+        )
+    )
 }
 
 /// What the clouds depend on besides the camera, time and sun: a change rebuilds them all.

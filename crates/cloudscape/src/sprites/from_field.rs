@@ -21,7 +21,7 @@ use rayon::prelude::*;
 
 use super::model::{SpriteBox, SpriteCloud, assign_groups, cull, dress, unit_random};
 use crate::field::noise::pcg_hash;
-use crate::field::{CloudField, LayerField, profile};
+use crate::field::{CloudField, CoarseFieldReader, LayerField, profile};
 use crate::particles::generate::world_point;
 use crate::scene::CloudType;
 
@@ -93,16 +93,58 @@ impl FieldTiling {
         xz - layer.wind_m_per_s * self.time_s
     }
 
-    /// The clouds of `keys`, in parallel; clear tiles give none.
-    pub fn clouds(&self, field: &CloudField, keys: &[TileKey]) -> Vec<(TileKey, SpriteCloud)> {
-        keys.par_iter()
-            .filter_map(|&key| Some((key, self.cloud(field, key)?)))
+    /// The clouds of `keys` (None where a tile is clear), their densities read by `reader` at
+    /// this tiling's time.
+    pub fn clouds(
+        &self,
+        field: &CloudField,
+        keys: &[TileKey],
+        reader: &dyn CoarseFieldReader,
+    ) -> Vec<Option<SpriteCloud>> {
+        let drafts: Vec<Option<TileDraft>> =
+            keys.par_iter().map(|&key| self.draft(field, key)).collect();
+        self.finish(field, &drafts, reader)
+    }
+
+    /// The clouds of `drafts`, each from its candidates' densities: every candidate of every
+    /// draft read in one call to `reader`, at this tiling's time.
+    pub fn finish(
+        &self,
+        field: &CloudField,
+        drafts: &[Option<TileDraft>],
+        reader: &dyn CoarseFieldReader,
+    ) -> Vec<Option<SpriteCloud>> {
+        let points: Vec<Vec3> = drafts
+            .iter()
+            .flatten()
+            .flat_map(|d| {
+                let wind = layer_drift_m(&field.layers[d.layer as usize], self.time_s);
+                d.points_m.iter().map(move |&p| p + wind)
+            })
+            .collect();
+        let extinctions = reader.coarse_extinctions_per_m(&points);
+        let mut at = 0;
+        let mut read = Vec::with_capacity(drafts.len());
+        for draft in drafts {
+            read.push(draft.as_ref().map(|d| {
+                let span = at..at + d.points_m.len();
+                at = span.end;
+                (d, span)
+            }));
+        }
+        read.into_par_iter()
+            .map(|r| {
+                let (draft, span) = r?;
+                let layer = &field.layers[draft.layer as usize];
+                draft.finish(&extinctions[span], layer.extinction_per_m)
+            })
             .collect()
     }
 
-    /// The cloud of one tile, in the layer's wind frame (place it at scene time t by adding
-    /// `wind t`); None where the tile is clear.
-    pub fn cloud(&self, field: &CloudField, key: TileKey) -> Option<SpriteCloud> {
+    /// The draft of one tile's cloud, in the layer's wind frame at time 0: its type and its
+    /// candidate sprites after the cull, nothing that coverage changes (no density is read);
+    /// None where the tile's type has no band to fill.
+    pub fn draft(&self, field: &CloudField, key: TileKey) -> Option<TileDraft> {
         let layer = &field.layers[key.layer as usize];
         let tile = IVec2::from_array(key.tile);
         let origin = tile.as_vec2() * self.tile_m;
@@ -113,37 +155,86 @@ impl FieldTiling {
             .sample((middle / field.weather.extent_m + layer.weather_offset).extend(0.0));
         let type_coord = layer.types.type_coord(weather.y);
         let (bottom, top) = profile_band(layer, type_coord)?;
-        let height = NOMINAL_HEIGHT * (top - bottom).min(self.tile_m);
-        let cloud_type = CloudType::from_field(type_coord, bottom, height);
+        let height_m = NOMINAL_HEIGHT * (top - bottom).min(self.tile_m);
+        let cloud_type = CloudType::from_field(type_coord, bottom, height_m);
         let recipe = cloud_type.recipe();
         let seed = pcg_hash(
             pcg_hash(layer.noise_offset_m.x.to_bits())
                 ^ pcg_hash(tile.x as u32 ^ pcg_hash(tile.y as u32)),
         );
-        let radius = recipe.cull_fraction * height;
+        let radius = recipe.cull_fraction * height_m;
         let cells = self.tile_m * self.tile_m * (top - bottom) / radius.powi(3);
         let n = ((cells * CANDIDATES_PER_CELL) as u32).clamp(recipe.sprites, MAX_CANDIDATES);
-        let point = |k: u32| {
-            let u = |lane| unit_random(seed, k, lane);
-            let xz = origin + Vec2::new(u(0), u(1)) * self.tile_m;
-            (xz, bottom + u(2) * (top - bottom))
-        };
         let candidates: Vec<Vec3> = (0..n)
             .map(|k| {
-                let (xz, altitude) = point(k);
-                Vec3::new(xz.x, altitude, xz.y)
+                let u = |lane| unit_random(seed, k, lane);
+                let xz = origin + Vec2::new(u(0), u(1)) * self.tile_m;
+                Vec3::new(xz.x, bottom + u(2) * (top - bottom), xz.y)
             })
             .collect();
-        let centre = world_point(field, middle, 0.5 * (bottom + top));
-        let sprites: Vec<_> = cull(&candidates, radius)
+        let points_m = cull(&candidates, radius)
+            .into_iter()
+            .map(|c| world_point(field, Vec2::new(c.x, c.z), c.y))
+            .collect();
+        Some(TileDraft {
+            cloud_type,
+            seed,
+            centre_m: world_point(field, middle, 0.5 * (bottom + top)),
+            height_m,
+            layer: key.layer,
+            tile_m: self.tile_m,
+            points_m,
+        })
+    }
+}
+
+/// How far `layer`'s wind has carried its clouds by `time_s`, m.
+fn layer_drift_m(layer: &LayerField, time_s: f32) -> Vec3 {
+    let drift = layer.wind_m_per_s * time_s;
+    Vec3::new(drift.x, 0.0, drift.y)
+}
+
+/// A tile's cloud before the field's density is read (made once per tile, kept through coverage
+/// edits): its type and its candidate sprites after Wang 2003's cull.
+#[derive(Clone, Debug)]
+pub struct TileDraft {
+    cloud_type: CloudType,
+    seed: u32,
+    /// The cloud's centre, in the layer's wind frame at time 0, m.
+    centre_m: Vec3,
+    /// The cloud's nominal height, which its sprite sizes are fractions of, m.
+    height_m: f32,
+    layer: u32,
+    tile_m: f32,
+    /// The candidates' centres after the cull, in the layer's wind frame at time 0, m.
+    points_m: Vec<Vec3>,
+}
+
+impl TileDraft {
+    /// The cloud of the candidates where the field is cloudy, each with its opacity ramped up
+    /// by the density (`extinctions_per_m`, one per candidate, of a layer whose densest
+    /// extinction is `layer_extinction_per_m`); None where the tile is clear.
+    fn finish(
+        &self,
+        extinctions_per_m: &[f32],
+        layer_extinction_per_m: f32,
+    ) -> Option<SpriteCloud> {
+        let recipe = self.cloud_type.recipe();
+        let sprites: Vec<_> = self
+            .points_m
             .iter()
+            .zip(extinctions_per_m)
             .enumerate()
-            .filter_map(|(k, c)| {
-                let p = world_point(field, Vec2::new(c.x, c.z), c.y);
-                let density = field.coarse_extinction_per_m(p, 0.0) / layer.extinction_per_m;
-                let presence = (density / PRESENCE_RAMP).min(1.0);
+            .filter_map(|(k, (&p, &extinction))| {
+                let presence = (extinction / layer_extinction_per_m / PRESENCE_RAMP).min(1.0);
                 (presence >= MIN_PRESENCE).then(|| {
-                    let mut s = dress(&recipe, seed, k as u32, p - centre, height);
+                    let mut s = dress(
+                        &recipe,
+                        self.seed,
+                        k as u32,
+                        p - self.centre_m,
+                        self.height_m,
+                    );
                     s.opacity *= presence;
                     s
                 })
@@ -153,10 +244,10 @@ impl FieldTiling {
             return None;
         }
         let mut cloud = SpriteCloud {
-            cloud_type,
-            center_m: centre,
+            cloud_type: self.cloud_type,
+            center_m: self.centre_m,
             boxes: Vec::new(),
-            layer: Some(key.layer),
+            layer: Some(self.layer),
             sprites,
         };
         cloud.boxes = column_boxes(&cloud, self.tile_m);
@@ -217,6 +308,7 @@ fn column_boxes(cloud: &SpriteCloud, tile_m: f32) -> Vec<SpriteBox> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::field::CpuCoarseReader;
     use crate::scene::Scene;
     use std::path::Path;
 
@@ -236,7 +328,16 @@ mod tests {
     fn field_clouds_sit_where_the_field_is_cloudy_and_form_from_their_cores() {
         let (thin, thick) = (field(0.35), field(0.6));
         let keys = TILING.tiles_around(&thin, glam::Vec3::ZERO);
-        let clouds = TILING.clouds(&thin, &keys);
+        let read = |f| CpuCoarseReader {
+            field: f,
+            time_s: 0.0,
+        };
+        let made = TILING.clouds(&thin, &keys, &read(&thin));
+        let clouds: Vec<_> = keys
+            .iter()
+            .zip(made)
+            .filter_map(|(k, c)| Some((k, c?)))
+            .collect();
         assert!(
             !clouds.is_empty() && clouds.len() < keys.len(),
             "{} of {}",
@@ -259,8 +360,8 @@ mod tests {
             }
             // More coverage keeps every sprite where it was, at least as opaque, and adds more:
             // clouds grow from their cores outward and dissipate back from their edges.
-            let more = TILING
-                .cloud(&thick, *key)
+            let more = TILING.clouds(&thick, &[**key], &read(&thick))[0]
+                .clone()
                 .expect("a cloud stays when coverage grows");
             for s in &cloud.sprites {
                 let same = more
@@ -279,7 +380,16 @@ mod tests {
     fn a_clear_sky_makes_no_field_clouds() {
         let clear = field(0.0);
         let keys = TILING.tiles_around(&clear, glam::Vec3::ZERO);
-        assert!(TILING.clouds(&clear, &keys).is_empty());
+        let read = CpuCoarseReader {
+            field: &clear,
+            time_s: 0.0,
+        };
+        assert!(
+            TILING
+                .clouds(&clear, &keys, &read)
+                .iter()
+                .all(Option::is_none)
+        );
     }
 
     #[test]

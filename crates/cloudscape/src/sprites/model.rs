@@ -173,16 +173,89 @@ pub fn unit_random(seed: u32, k: u32, lane: u32) -> f32 {
 
 /// The candidates that survive Wang 2003's cull: in order, each kept unless its centre lies within
 /// `radius_m` of a centre kept before it. So no two kept centres are closer than the radius, and
-/// every culled candidate has a kept one within it.
+/// every culled candidate has a kept one within it. The kept centres are listed in a grid of cells
+/// at least one radius wide, so each candidate looks only at the 27 cells around it.
 pub fn cull(candidates: &[Vec3], radius_m: f32) -> Vec<Vec3> {
     let r2 = radius_m * radius_m;
+    let grid = CullGrid::new(candidates, radius_m);
+    let mut heads = vec![u32::MAX; grid.cells()];
+    let mut next: Vec<u32> = Vec::with_capacity(candidates.len());
     let mut kept: Vec<Vec3> = Vec::with_capacity(candidates.len());
     for &c in candidates {
-        if kept.iter().all(|k| k.distance_squared(c) >= r2) {
+        let home = grid.cell(c);
+        let clear = grid.around(home).all(|cell| {
+            let mut k = heads[cell];
+            while k != u32::MAX {
+                if kept[k as usize].distance_squared(c) < r2 {
+                    return false;
+                }
+                k = next[k as usize];
+            }
+            true
+        });
+        if clear {
+            let slot = grid.index(home);
+            next.push(heads[slot]);
+            heads[slot] = kept.len() as u32;
             kept.push(c);
         }
     }
     kept
+}
+
+/// The cells of [`cull`]: a box over the candidates cut into cells at least the radius wide, and
+/// wide enough that there are at most about four cells per candidate.
+struct CullGrid {
+    lo: Vec3,
+    cell_m: f32,
+    dims: glam::IVec3,
+}
+
+impl CullGrid {
+    fn new(candidates: &[Vec3], radius_m: f32) -> CullGrid {
+        let (lo, hi) = candidates
+            .iter()
+            .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &c| {
+                (lo.min(c), hi.max(c))
+            });
+        let (lo, extent) = match candidates.is_empty() {
+            true => (Vec3::ZERO, Vec3::ZERO),
+            false => (lo, hi - lo),
+        };
+        let volume = extent
+            .max(Vec3::splat(radius_m.max(1e-3)))
+            .element_product();
+        let sparse = (volume / (4.0 * candidates.len().max(1) as f32)).cbrt();
+        let cell_m = radius_m.max(sparse).max(1e-3);
+        let dims = (extent / cell_m).floor().as_ivec3() + 1;
+        CullGrid { lo, cell_m, dims }
+    }
+
+    fn cells(&self) -> usize {
+        self.dims.element_product() as usize
+    }
+
+    fn cell(&self, p: Vec3) -> glam::IVec3 {
+        ((p - self.lo) / self.cell_m)
+            .floor()
+            .as_ivec3()
+            .clamp(glam::IVec3::ZERO, self.dims - 1)
+    }
+
+    fn index(&self, c: glam::IVec3) -> usize {
+        (c.x + self.dims.x * (c.y + self.dims.y * c.z)) as usize
+    }
+
+    /// The indices of the cells around `home` (itself included) inside the grid.
+    fn around(&self, home: glam::IVec3) -> impl Iterator<Item = usize> + '_ {
+        let lo = (home - 1).max(glam::IVec3::ZERO);
+        let hi = (home + 1).min(self.dims - 1);
+        (lo.z..=hi.z).flat_map(move |z| {
+            (lo.y..=hi.y).flat_map(move |y| {
+                (lo.x..=hi.x).map(move |x| self.index(glam::IVec3::new(x, y, z)))
+            })
+        })
+    }
 }
 
 /// The sprite at `offset_m`, sized, turned and textured from the recipe's ranges (`height_m`: the

@@ -17,6 +17,7 @@ use super::views::{
     sort_view, wind_offsets_m,
 };
 use crate::field::FieldError;
+use crate::field::read_gpu::FieldReadPass;
 use crate::gpu::pipeline::{
     PREMULTIPLIED_OVER, RasterDescriptor, dispatch_2d, storage_buffer, uniform_buffer,
 };
@@ -25,7 +26,7 @@ use crate::optics::PhaseLobes;
 use crate::pass::{BindGroupCache, ComputePass, RasterPass, Shared};
 use crate::shader::WgslModule;
 
-use crate::scene::Scene;
+use crate::scene::{LightingModel, Scene};
 use crate::technique::{Draws, FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 
 /// The timed passes of a frame, in order (the impostor pass only in frames that render one).
@@ -44,9 +45,10 @@ struct SettingsUniform {
     directional_overridden: u32,
     phase_lobes: Vec4,
     albedo: f32,
-    pad0: f32,
+    lit_by_volume: u32,
     pad1: f32,
     pad2: f32,
+    slab_params: Vec4,
 }
 
 /// One sector of the `Ring` uniform of `sprite_impostor.wgsl`.
@@ -231,6 +233,8 @@ pub struct SpriteRenderer {
     sheet: wgpu::TextureView,
     sampler: wgpu::Sampler,
     set: CloudSet,
+    /// Reads the field's density at the candidate sprites of new tiles.
+    field_read: FieldReadPass,
     uploaded: Option<(u64, wgpu::Buffer, wgpu::Buffer)>,
     main: ViewBuffers,
     ring: Option<Ring>,
@@ -303,6 +307,7 @@ impl SpriteRenderer {
                 ..Default::default()
             }),
             set: CloudSet::default(),
+            field_read: FieldReadPass::new(ctx, shared),
             uploaded: None,
             main: ViewBuffers::new(ctx, "sprite view"),
             ring: None,
@@ -620,6 +625,13 @@ impl Technique for SpriteRenderer {
                 directional_overridden: scene.sprites.directional_color.is_some() as u32,
                 phase_lobes: Vec4::from_array(PhaseLobes::from_scene(&scene.phase).to_gpu()),
                 albedo: scene.lighting.albedo,
+                lit_by_volume: u32::from(scene.lighting.model == LightingModel::Volume),
+                slab_params: Vec4::from_array(
+                    scene
+                        .lighting
+                        .sun_slab(PhaseLobes::from_scene(&scene.phase))
+                        .params_to_gpu(),
+                ),
                 ..SettingsUniform::zeroed()
             },
         });
@@ -630,8 +642,13 @@ impl Technique for SpriteRenderer {
         let configured = self.configured.expect("configure comes before prepare");
         let frame = inputs.frame;
         let eye = frame.camera_position_m;
-        self.set
-            .update(inputs.field, eye, frame.sun.direction, frame.time_s);
+        let reader = self.field_read.reader(ctx, inputs.shared);
+        self.set.update(
+            inputs.field,
+            &reader,
+            (eye, frame.sun.direction),
+            frame.time_s,
+        );
         self.upload_set(ctx);
         let offsets = wind_offsets_m(&configured.winds_m_per_s, frame.time_s);
         let settings = SettingsUniform {
@@ -767,6 +784,11 @@ impl Technique for SpriteRenderer {
 
     fn finish_frame(&mut self, _encoder: &mut wgpu::CommandEncoder) {}
 
+    fn reads_light_volume(&self) -> bool {
+        self.configured
+            .is_some_and(|c| c.uniform.lit_by_volume == 1)
+    }
+
     fn stats(&mut self, _ctx: &GpuContext) -> Option<TechniqueStats> {
         Some(TechniqueStats {
             pixels: self.pixels,
@@ -785,6 +807,7 @@ pub static SPRITE_RENDER_WGSL: crate::shader::WgslModule = crate::shader::wgsl_m
         &crate::frame::FRAME_WGSL,
         &crate::environment::ENVIRONMENT_WGSL,
         &crate::optics::phase::PHASE_WGSL,
+        &crate::optics::slab::SLAB_WGSL,
         &super::views::SPRITE_WGSL
     ]
 );
@@ -821,9 +844,10 @@ mod tests {
                 directional_overridden,
                 phase_lobes,
                 albedo,
-                pad0,
+                lit_by_volume,
                 pad1,
                 pad2,
+                slab_params,
             }
         );
         assert_wgsl_layout!(

@@ -88,7 +88,7 @@ pub fn level_at(levels: &[ColorLevel; LEVELS], h: f32) -> Vec4 {
 
 /// The light of one shading group: the diffuse directional factor and the direct sun's
 /// transmittance to it.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GroupLight {
     /// Directional factor, 0..1 (times the maximum directional colour).
     pub directional: f32,

@@ -1,6 +1,7 @@
 // The sprite pass (sprites/render.rs): every sprite of the view's sorted list, back to front, as
 // a textured quad blended over the ones behind it. Shading follows Wang 2003 with physically
-// derived numbers (sprites/shading.rs, the CPU specification); the in-cloud lock, fades and
+// derived numbers (sprites/shading.rs, the CPU specification), or, for the field's sprites in a
+// frame with a light volume, as the ray marcher lights the field; the in-cloud lock, fades and
 // formation are per vertex.
 
 // One sprite (sprites::render::GpuSprite).
@@ -35,9 +36,10 @@ struct Settings {
     directional_overridden: u32,
     phase_lobes: vec4<f32>,             // the scene's phase function (phase.wgsl)
     albedo: f32,                        // single-scattering albedo
-    pad0: f32,
+    lit_by_volume: u32,                 // 1: field sprites read the frame's light volume
     pad1: f32,
     pad2: f32,
+    slab_params: vec4<f32>,             // the forward peak's beam (slab.wgsl, SunSlab)
 }
 
 @group(3) @binding(0) var<uniform> view: View;
@@ -54,6 +56,7 @@ struct Varying {
     @location(0) uv: vec2<f32>,                 // on the puff sheet
     @location(1) diffuse: vec3<f32>,            // ambient + directional radiance
     @location(2) single: vec3<f32>,             // single-scattered sun (silver lining)
+    @location(7) thin_only: f32,                // 1: the single-scattered sun lights only thin parts
     @location(3) opacity: f32,                  // fades and the level's opacity
     @location(6) optical_depth: f32,            // the sprite's, through its densest column
     @location(4) distance_m: f32,
@@ -123,14 +126,28 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     let level = sprite_level(c.colors, heights, clamp((p.y - c.bottom_y_m) / max(c.height_m, 1.0), 0.0, 1.0));
     let maxima = sprite_max_colours(p);
     let view_dir = normalize(p - view.eye_m);
-    let phase = phase_eval(settings.phase_lobes, dot(view_dir, environment_sun_direction()));
+    let cos_sun = dot(view_dir, environment_sun_direction());
+    let phase = phase_eval(settings.phase_lobes, cos_sun);
+    let wang_diffuse = level.rgb * maxima[0] + s.directional * maxima[1];
+    let wang_single = settings.albedo * environment_sun_irradiance(p) * s.sun_transmittance * phase;
+    // Field sprites in a frame with a light volume: lit as the ray marcher lights a sample of
+    // the field halfway between the sprite's centre and this corner (so a sprite shades from its
+    // sunlit to its shadowed side): the volume's diffuse light, and the sun's beam (single
+    // scattering and the forward peak) after the cloud shadow map's optical depth toward the sun.
+    let q = mix(centre, p, 0.5);
+    let volume = s.layer < 4u && settings.lit_by_volume == 1u && environment_has_light_volume();
+    let tau_sun = environment_cloud_sun_optical_depth(q);
+    let slab = SlabModel(settings.phase_lobes, settings.slab_params);
+    let volume_single = settings.albedo * environment_sun_irradiance(q) * slab_beam_scattering(slab, cos_sun, tau_sun);
+    let volume_diffuse = settings.albedo * environment_light_volume_diffuse(q, -view_dir);
 
     var out: Varying;
     out.clip = sprite_clip(view, p);
     let tile = vec2<f32>(f32(s.texture % 4u), f32(s.texture / 4u));
     out.uv = (tile + corner * vec2<f32>(0.5, -0.5) + 0.5) / SHEET_TILES;
-    out.diffuse = level.rgb * maxima[0] + s.directional * maxima[1];
-    out.single = settings.albedo * environment_sun_irradiance(p) * s.sun_transmittance * phase;
+    out.diffuse = select(wang_diffuse, volume_diffuse, volume);
+    out.single = select(wang_single, volume_single, volume);
+    out.thin_only = select(1.0, 0.0, volume);
     out.opacity = level.a * through * edge_on * far;
     out.optical_depth = s.optical_depth;
     out.distance_m = length(p - view.eye_m);
@@ -150,6 +167,6 @@ fn fs_sprite(in: Varying) -> SpriteTargets {
     // Thin parts of a puff scatter the direct sun once toward the eye (premultiplied, E p tau ~
     // E p alpha for thin matter); its thick core's light is the diffuse term's.
     let thin = (1.0 - cover) * (1.0 - cover);
-    let radiance = alpha * (in.diffuse + thin * in.single);
+    let radiance = alpha * (in.diffuse + mix(1.0, thin, in.thin_only) * in.single);
     return sprite_targets(radiance, alpha, in.distance_m);
 }
