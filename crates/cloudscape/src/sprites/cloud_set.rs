@@ -307,6 +307,23 @@ impl CloudSet {
         )
     }
 
+    /// The sun's light as last lit, at the extinction of clouds of no layer.
+    pub(super) fn light(&self) -> SunLight {
+        self.light.with_extinction(self.default_extinction_per_m)
+    }
+
+    /// Whether the field's clouds are drawn.
+    pub(super) fn has_field_clouds(&self) -> bool {
+        self.tiling.is_some()
+    }
+
+    /// The hand-made and model-file clouds, with their colour levels (None: derived).
+    pub(super) fn authored_clouds(
+        &self,
+    ) -> impl Iterator<Item = (&SpriteCloud, Option<[ColorLevel; LEVELS]>)> {
+        self.authored.iter().map(|(cloud, levels)| (cloud, *levels))
+    }
+
     /// Every cloud drawn, as the model file would hold it (field clouds as made this frame).
     pub fn sprite_clouds(&self) -> Vec<SpriteCloud> {
         self.authored

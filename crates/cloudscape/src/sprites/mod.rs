@@ -8,6 +8,7 @@
 //! - [`from_field`]: clouds from the cloud field, in wind-borne tiles;
 //! - [`textures`]: the 4 x 4 sheet of puffs, baked from the reference particle;
 //! - [`shading`]: colour levels, shading groups, directional and single-scattered light;
+//! - [`inside`]: the fog that stands for the sprites the eye has passed, inside a cloud;
 //! - [`file`]: sprite model files;
 //! - [`cloud_set`], [`views`], [`impostors`], [`render`]: the technique on the GPU.
 
@@ -15,6 +16,7 @@ pub mod cloud_set;
 pub mod file;
 pub(crate) mod from_field;
 pub mod impostors;
+pub mod inside;
 pub(crate) mod model;
 pub(crate) mod render;
 pub mod shading;

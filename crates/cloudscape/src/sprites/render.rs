@@ -10,6 +10,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, Vec3, Vec4};
 
 use super::cloud_set::{Authored, CloudSet, GpuCloud, GpuSprite, authored_clouds};
+use super::inside::InCloudFog;
 use super::impostors::{ASPECT, SECTORS, SectorView};
 use super::textures::{SHEET_TEXELS, bake_sheet};
 use super::views::{
@@ -48,6 +49,24 @@ struct SettingsUniform {
     lit_by_volume: u32,
     pad1: f32,
     pad2: f32,
+    slab_params: Vec4,
+}
+
+/// The `Resolve` uniform of `sprite_resolve.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct ResolveUniform {
+    origin: UVec2,
+    size: UVec2,
+    fog_box_min_m: Vec3,
+    fog_extinction_per_m: f32,
+    fog_box_max_m: Vec3,
+    fog_depth_m: f32,
+    fog_ambient: f32,
+    fog_directional: f32,
+    fog_lit_by_volume: u32,
+    albedo: f32,
+    phase_lobes: Vec4,
     slab_params: Vec4,
 }
 
@@ -244,6 +263,8 @@ pub struct SpriteRenderer {
     no_depth: wgpu::TextureView,
     resolve_groups: BindGroupCache,
     stats: SpriteStats,
+    /// The fog around the eye this frame (none outside clouds).
+    fog: InCloudFog,
     pixels: u32,
     /// What [`Technique::configure`] took from the scene.
     configured: Option<Configured>,
@@ -298,7 +319,7 @@ impl SpriteRenderer {
                 &["resolve_sprites"],
             ),
             settings: uniform_buffer(ctx, "sprite settings", size_of::<SettingsUniform>() as u64),
-            resolve: uniform_buffer(ctx, "sprite resolve", 16),
+            resolve: uniform_buffer(ctx, "sprite resolve", size_of::<ResolveUniform>() as u64),
             sheet: upload_sheet(ctx),
             sampler: ctx.device.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some("sprites"),
@@ -324,6 +345,7 @@ impl SpriteRenderer {
             .create_view(&Default::default()),
             resolve_groups: BindGroupCache::default(),
             stats: SpriteStats::default(),
+            fog: InCloudFog::default(),
             pixels: 0,
             configured: None,
             authored: None,
@@ -658,6 +680,9 @@ impl Technique for SpriteRenderer {
         ctx.queue
             .write_buffer(&self.settings, 0, bytemuck::bytes_of(&settings));
         let views = configured.views;
+        self.fog = self
+            .set
+            .fog_at(inputs.field, eye, frame.time_s, views.lock_distance_m);
         let view = ViewUniform::of_frame(frame, inputs.grid, &views);
         let reach = match views.ring_radius_m {
             r if r > 0.0 => Reach::Within(r),
@@ -752,8 +777,24 @@ impl Technique for SpriteRenderer {
                 self.main.count,
             );
         }
+        let settings = self.configured.expect("configure comes before encode").uniform;
+        let fog = self.fog;
+        let uniform = ResolveUniform {
+            origin,
+            size,
+            fog_box_min_m: fog.box_m.0,
+            fog_extinction_per_m: fog.extinction_per_m,
+            fog_box_max_m: fog.box_m.1,
+            fog_depth_m: fog.depth_m,
+            fog_ambient: fog.ambient,
+            fog_directional: fog.directional,
+            fog_lit_by_volume: u32::from(fog.from_field) * settings.lit_by_volume,
+            albedo: settings.albedo,
+            phase_lobes: settings.phase_lobes,
+            slab_params: settings.slab_params,
+        };
         ctx.queue
-            .write_buffer(&self.resolve, 0, bytemuck::cast_slice(&[origin, size]));
+            .write_buffer(&self.resolve, 0, bytemuck::bytes_of(&uniform));
         let resolve = &self.resolve_pass;
         let resolve_group = self
             .resolve_groups
@@ -823,7 +864,13 @@ pub static SPRITE_IMPOSTOR_WGSL: crate::shader::WgslModule = crate::shader::wgsl
 pub static SPRITE_RESOLVE_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
     "sprite_resolve",
     "sprite_resolve.wgsl",
-    [&super::views::SPRITE_WGSL]
+    [
+        &crate::shader::MATH_WGSL,
+        &crate::environment::ENVIRONMENT_WGSL,
+        &crate::optics::phase::PHASE_WGSL,
+        &crate::optics::slab::SLAB_WGSL,
+        &super::views::SPRITE_WGSL
+    ]
 );
 
 #[cfg(test)]
@@ -847,6 +894,24 @@ mod tests {
                 lit_by_volume,
                 pad1,
                 pad2,
+                slab_params,
+            }
+        );
+        assert_wgsl_layout!(
+            &crate::sprites::render::SPRITE_RESOLVE_WGSL,
+            "Resolve",
+            ResolveUniform {
+                origin,
+                size,
+                fog_box_min_m,
+                fog_extinction_per_m,
+                fog_box_max_m,
+                fog_depth_m,
+                fog_ambient,
+                fog_directional,
+                fog_lit_by_volume,
+                albedo,
+                phase_lobes,
                 slab_params,
             }
         );

@@ -159,9 +159,12 @@ impl SunLight {
 
 /// Wang 2003's directional factor of a group at `offset_m` from its cloud's centre, for a cloud of
 /// diameter `diameter_m`: from the two-stream diffuse transmittance across the cloud on the far
-/// side (the light that diffuses through a slab that thick) to 1 on the side facing the sun.
+/// side (the light that diffuses through a slab that thick) to 1 on the side facing the sun. How
+/// far a group faces the sun grows with its offset out to the cloud's radius, so the light is
+/// continuous through the centre (where the eye may fly).
 pub fn wang_group_light(light: &SunLight, offset_m: Vec3, diameter_m: f32) -> GroupLight {
-    let facing = 0.5 + 0.5 * light.sun.dot(offset_m.normalize_or_zero());
+    let reach = (offset_m / (0.5 * diameter_m).max(1e-3)).clamp_length_max(1.0);
+    let facing = 0.5 + 0.5 * light.sun.dot(reach);
     let tau = light.extinction_per_m * MEAN_RELATIVE_DENSITY * diameter_m * (1.0 - facing);
     GroupLight {
         directional: diffuse_transmittance(tau, light.g),
@@ -239,13 +242,18 @@ mod tests {
             g: 0.8,
             extinction_per_m: 0.05,
         };
-        let near = wang_group_light(&light, Vec3::X * 300.0, 1000.0);
-        let side = wang_group_light(&light, Vec3::Z * 300.0, 1000.0);
-        let far = wang_group_light(&light, -Vec3::X * 300.0, 1000.0);
+        let near = wang_group_light(&light, Vec3::X * 500.0, 1000.0);
+        let side = wang_group_light(&light, Vec3::Z * 500.0, 1000.0);
+        let far = wang_group_light(&light, -Vec3::X * 500.0, 1000.0);
         assert_eq!((near.directional, near.sun_transmittance), (1.0, 1.0));
         assert!(far.directional < side.directional && side.directional < 1.0);
         assert!((far.directional - diffuse_transmittance(25.0, 0.8)).abs() < 1e-6);
         assert!(far.sun_transmittance < 1e-6);
+        // Halfway out toward the sun, halfway lit; continuous through the centre.
+        let halfway = wang_group_light(&light, Vec3::X * 250.0, 1000.0);
+        assert!((halfway.sun_transmittance - (-6.25f32).exp()).abs() < 1e-6);
+        let [a, b] = [1.0, -1.0].map(|s| wang_group_light(&light, Vec3::X * s, 1000.0));
+        assert!((a.directional - b.directional).abs() < 1e-3);
         // One octave is Beer-Lambert; more octaves carry light deeper.
         let beer = SunLight {
             octaves: 1,
