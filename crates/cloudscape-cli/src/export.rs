@@ -1,5 +1,6 @@
-//! `cloudscape export`: the cloud field over a box as a Mitsuba 3 `.vol` grid and scene, or
-//! (`--sprites`) the scene's sprite clouds as a sprite model file.
+//! `cloudscape export`: the cloud field over a box as a Mitsuba 3 `.vol` grid and scene,
+//! (`--sprites`) the scene's sprite clouds as a sprite model file, or (`--puff-sheet`) the sprite
+//! technique's puffs as a picture.
 
 use crate::common::{SceneArgs, Stages};
 use anyhow::{Result, anyhow};
@@ -17,12 +18,16 @@ pub struct ExportArgs {
     #[command(flatten)]
     scene: SceneArgs,
     /// Directory to write `clouds.vol` and `scene.xml` into (created if missing).
-    #[arg(long, required_unless_present = "sprites")]
+    #[arg(long, required_unless_present_any = ["sprites", "puff_sheet"])]
     out: Option<PathBuf>,
     /// Write the scene's sprite clouds (hand-made, model file and the field's around the camera)
     /// to this sprite model file instead; `sprites.model` draws it.
     #[arg(long, conflicts_with = "out")]
     sprites: Option<PathBuf>,
+    /// Write the sprite technique's sheet of 16 puffs to this PNG instead (each at the highest
+    /// optical depth a sprite gets, over a sky blue; two pixels per texel).
+    #[arg(long, conflicts_with_all = ["out", "sprites"])]
+    puff_sheet: Option<PathBuf>,
     /// Voxels along the longest side of the box.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(2..=2048))]
     resolution: u32,
@@ -51,6 +56,12 @@ fn export_box(field: &CloudField, camera: Vec3, size_m: f32) -> Option<(Vec3, Ve
 /// Samples the field and writes the Mitsuba scene, or writes the sprite model.
 pub fn run(args: ExportArgs) -> Result<()> {
     let mut stages = Stages::new();
+    if let Some(path) = &args.puff_sheet {
+        let sheet = stages.run("baking the puffs", || {
+            Ok(cloudscape::sprites::puff_sheet_preview(2))
+        })?;
+        return stages.run("writing image", || Ok(sheet.write_png(path)?));
+    }
     let doc = stages.run("loading scene", || args.scene.load(&[]))?;
     let scene = &doc.scene;
     let field = stages.run("building cloud field", || {
@@ -60,7 +71,11 @@ pub fn run(args: ExportArgs) -> Result<()> {
     let out = match (&args.sprites, &args.out) {
         (Some(path), _) => return write_sprites(&doc, &field, path, stages),
         (None, Some(out)) => out,
-        (None, None) => return Err(anyhow!("give --out DIR (Mitsuba) or --sprites FILE")),
+        (None, None) => {
+            return Err(anyhow!(
+                "give --out DIR (Mitsuba), --sprites FILE or --puff-sheet PNG"
+            ));
+        }
     };
     let camera = Vec3::from_array(scene.camera.position_m);
     let (min, max) = export_box(&field, camera, args.size_km * 1000.0)

@@ -295,7 +295,13 @@ impl CloudSet {
                     rotation_rad: s.rotation_rad,
                     texture: s.texture,
                     cloud: 0,
-                    optical_depth: s.opacity * sprite_optical_depth(light, s.size_m.x),
+                    optical_depth: match from_field {
+                        true => s.opacity * shading::MAX_SPRITE_OPTICAL_DEPTH,
+                        false => {
+                            s.opacity
+                                * shading::sprite_optical_depth(light.extinction_per_m, s.size_m.x)
+                        }
+                    },
                     directional: group.directional,
                     sun_transmittance: group.sun_transmittance,
                 }
@@ -393,17 +399,6 @@ fn levels_of(spec: &SpriteCloudSpec) -> Option<[ColorLevel; LEVELS]> {
             rgba: Vec4::new(r, g, b, a),
         }
     }))
-}
-
-/// Sprite optical depth at most: beyond it a puff's core is opaque anyway, and its soft edge is
-/// kept (a sphere of cloud as dense as its layer would be a hard-edged ball).
-pub const MAX_SPRITE_OPTICAL_DEPTH: f32 = 3.0;
-
-/// Optical depth through the densest column of a sprite `width_m` wide of the light's matter at
-/// its mean density.
-fn sprite_optical_depth(light: &SunLight, width_m: f32) -> f32 {
-    (light.extinction_per_m * shading::MEAN_RELATIVE_DENSITY * width_m)
-        .min(MAX_SPRITE_OPTICAL_DEPTH)
 }
 
 /// What the tiles' drafts depend on: the scene's layers but for their coverage, the weather, the

@@ -20,16 +20,19 @@ use glam::{IVec2, Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::model::{SpriteBox, SpriteCloud, assign_groups, cull, dress, unit_random};
+use super::shading::MAX_SPRITE_OPTICAL_DEPTH;
 use crate::field::noise::pcg_hash;
 use crate::field::{CloudField, CoarseFieldReader, LayerField, profile};
 use crate::particles::generate::world_point;
 use crate::scene::CloudType;
 
-/// Normalised coarse density (of the layer's densest) over which a sprite's opacity ramps from 0
-/// to full: its presence, `saturate(density / ramp)`.
-pub const PRESENCE_RAMP: f32 = 0.12;
-/// Sprites thinner than this presence are dropped.
-pub const MIN_PRESENCE: f32 = 0.02;
+/// Candidates where the coarse density (of the layer's densest) is below this are dropped.
+pub const MIN_DENSITY: f32 = 0.0025;
+/// A field sprite of a sheet is at least this many times as wide as the sheet's sprites are
+/// apart, so that they overlap into one veil (the recipes size sprites by the cloud's height,
+/// which leaves a thin deck small puffs with gaps between them; 4 measured by eye on the thin
+/// stratus deck, 2 and 3 still leave a mackerel sky).
+const MIN_WIDTH_PER_SPACING: f32 = 4.0;
 /// A field cloud's nominal height, which its cull radius and sprite sizes are fractions of, as a
 /// fraction of the band its type can fill: cumulus rarely fill the whole band (tuned by eye
 /// against the ray marcher on the default scene).
@@ -172,10 +175,11 @@ impl FieldTiling {
                 Vec3::new(xz.x, bottom + u(2) * (top - bottom), xz.y)
             })
             .collect();
-        let points_m = cull(&candidates, radius)
+        let points_m: Vec<Vec3> = cull(&candidates, radius)
             .into_iter()
             .map(|c| world_point(field, Vec2::new(c.x, c.z), c.y))
             .collect();
+        let cell_m3 = self.tile_m * self.tile_m * (top - bottom) / points_m.len().max(1) as f32;
         Some(TileDraft {
             cloud_type,
             seed,
@@ -184,7 +188,32 @@ impl FieldTiling {
             layer: key.layer,
             tile_m: self.tile_m,
             points_m,
+            cell_m3,
         })
+    }
+}
+
+/// A field sprite's opacity: the optical depth its puff needs to hold the matter of its cell,
+/// `cell_m3` of cloud of extinction `extinction_per_m`, over [`MAX_SPRITE_OPTICAL_DEPTH`] (a field
+/// sprite's optical depth is its opacity times that). The puff's optical depth integrated over its
+/// quad, `tau m w h` (`m` the puffs' mean normalised column density), equals the cell's `sigma V`:
+/// summed over overlapping sprites, a view through the cloud meets the field's optical depth,
+/// however many sprites stand for it, up to the soft-rim bound on each sprite.
+fn mass_opacity(extinction_per_m: f32, cell_m3: f32, size_m: Vec2) -> f32 {
+    let tau = extinction_per_m * cell_m3 / (super::textures::mean_cover() * size_m.x * size_m.y);
+    (tau / MAX_SPRITE_OPTICAL_DEPTH).clamp(0.0, 1.0)
+}
+
+impl TileDraft {
+    /// The least width of the sprites at `present` (the candidates where the tile is cloudy),
+    /// m: for a sheet ([`super::types::Recipe::sheet`]), [`MIN_WIDTH_PER_SPACING`] times how far
+    /// apart they lie across the tile (a deck covers its tiles); none for other clouds, whose
+    /// recipe sizes overlap.
+    fn least_width_m(&self, recipe: &super::types::Recipe, present: usize) -> f32 {
+        match recipe.sheet {
+            true => MIN_WIDTH_PER_SPACING * self.tile_m / (present.max(1) as f32).sqrt(),
+            false => 0.0,
+        }
     }
 }
 
@@ -208,36 +237,38 @@ pub struct TileDraft {
     tile_m: f32,
     /// The candidates' centres after the cull, in the layer's wind frame at time 0, m.
     points_m: Vec<Vec3>,
+    /// The volume of cloud each candidate stands for: the band over the tile, shared out, m^3.
+    cell_m3: f32,
 }
 
 impl TileDraft {
-    /// The cloud of the candidates where the field is cloudy, each with its opacity ramped up
-    /// by the density (`extinctions_per_m`, one per candidate, of a layer whose densest
-    /// extinction is `layer_extinction_per_m`); None where the tile is clear.
+    /// The cloud of the candidates where the field is cloudy (`extinctions_per_m`, one per
+    /// candidate, of a layer whose densest extinction is `layer_extinction_per_m`), each sprite
+    /// wide enough to overlap its neighbours and as opaque as the matter of its cell; None where
+    /// the tile is clear.
     fn finish(
         &self,
         extinctions_per_m: &[f32],
         layer_extinction_per_m: f32,
     ) -> Option<SpriteCloud> {
         let recipe = self.cloud_type.recipe();
-        let sprites: Vec<_> = self
+        let present: Vec<(usize, Vec3, f32)> = self
             .points_m
             .iter()
             .zip(extinctions_per_m)
             .enumerate()
-            .filter_map(|(k, (&p, &extinction))| {
-                let presence = (extinction / layer_extinction_per_m / PRESENCE_RAMP).min(1.0);
-                (presence >= MIN_PRESENCE).then(|| {
-                    let mut s = dress(
-                        &recipe,
-                        self.seed,
-                        k as u32,
-                        p - self.centre_m,
-                        self.height_m,
-                    );
-                    s.opacity *= presence;
-                    s
-                })
+            .filter(|(_, (_, e))| **e >= MIN_DENSITY * layer_extinction_per_m)
+            .map(|(k, (&p, &e))| (k, p, e))
+            .collect();
+        let least_width_m = self.least_width_m(&recipe, present.len());
+        let sprites: Vec<_> = present
+            .into_iter()
+            .map(|(k, p, extinction)| {
+                let offset = p - self.centre_m;
+                let mut s = dress(&recipe, self.seed, k as u32, offset, self.height_m);
+                s.size_m *= (least_width_m / s.size_m.x).max(1.0);
+                s.opacity = mass_opacity(extinction, self.cell_m3, s.size_m);
+                s
             })
             .collect();
         if sprites.is_empty() {

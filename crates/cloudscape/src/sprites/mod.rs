@@ -27,3 +27,4 @@ pub(crate) mod views;
 pub use file::ModelFile;
 pub use model::{CloudModel, Sprite, SpriteBox, SpriteCloud};
 pub use render::SpriteRenderer;
+pub use textures::puff_sheet_preview;

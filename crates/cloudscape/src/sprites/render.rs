@@ -10,9 +10,9 @@ use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, Vec3, Vec4};
 
 use super::cloud_set::{Authored, CloudSet, GpuCloud, GpuSprite, authored_clouds};
-use super::inside::InCloudFog;
 use super::impostors::{ASPECT, SECTORS, SectorView};
-use super::textures::{SHEET_TEXELS, bake_sheet};
+use super::inside::InCloudFog;
+use super::textures::{SHEET_TEXELS, sheet};
 use super::views::{
     Reach, SortedView, ViewSettings, ViewUniform, layer_winds_m_per_s, sector_elevations,
     sort_view, wind_offsets_m,
@@ -534,7 +534,7 @@ fn upload_sheet(ctx: &GpuContext) -> wgpu::TextureView {
     );
     ctx.queue.write_texture(
         texture.as_image_copy(),
-        &bake_sheet(),
+        sheet(),
         wgpu::TexelCopyBufferLayout {
             offset: 0,
             bytes_per_row: Some(SHEET_TEXELS),
@@ -777,7 +777,10 @@ impl Technique for SpriteRenderer {
                 self.main.count,
             );
         }
-        let settings = self.configured.expect("configure comes before encode").uniform;
+        let settings = self
+            .configured
+            .expect("configure comes before encode")
+            .uniform;
         let fog = self.fog;
         let uniform = ResolveUniform {
             origin,

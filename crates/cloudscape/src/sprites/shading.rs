@@ -86,6 +86,16 @@ pub fn level_at(levels: &[ColorLevel; LEVELS], h: f32) -> Vec4 {
     levels[LEVELS - 1].rgba
 }
 
+/// Sprite optical depth at most: beyond it a puff's core is opaque anyway, and its soft rim is
+/// kept (`textures.rs` tests the rim at this depth).
+pub const MAX_SPRITE_OPTICAL_DEPTH: f32 = 3.0;
+
+/// Optical depth through the densest column of a sprite `width_m` wide of matter of extinction
+/// `extinction_per_m` at its mean density, at most [`MAX_SPRITE_OPTICAL_DEPTH`].
+pub fn sprite_optical_depth(extinction_per_m: f32, width_m: f32) -> f32 {
+    (extinction_per_m * MEAN_RELATIVE_DENSITY * width_m).min(MAX_SPRITE_OPTICAL_DEPTH)
+}
+
 /// The light of one shading group: the diffuse directional factor and the direct sun's
 /// transmittance to it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

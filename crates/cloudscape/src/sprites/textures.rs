@@ -113,8 +113,24 @@ pub fn texture_in(mask: u16, u: f32) -> u32 {
     set[pick]
 }
 
+/// The sheet, baked once per process (about 0.1 s on two cores).
+pub fn sheet() -> &'static [u8] {
+    static SHEET: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    SHEET.get_or_init(bake_sheet)
+}
+
+/// The puffs' mean normalised column density over their tile (the share of a sprite's quad its
+/// puff's matter fills): what a sprite's optical depth is scaled by to hold a given mass.
+pub fn mean_cover() -> f32 {
+    static MEAN: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
+    *MEAN.get_or_init(|| {
+        let sheet = sheet();
+        sheet.iter().map(|&c| f32::from(c)).sum::<f32>() / (255.0 * sheet.len() as f32)
+    })
+}
+
 /// The whole sheet, row-major, one byte of normalised column density per texel.
-pub fn bake_sheet() -> Vec<u8> {
+fn bake_sheet() -> Vec<u8> {
     let tiles: Vec<Vec<u8>> = (0..SHEET_TILES * SHEET_TILES)
         .into_par_iter()
         .map(|i| Puff::new(i).bake())
@@ -130,6 +146,30 @@ pub fn bake_sheet() -> Vec<u8> {
         }
     }
     sheet
+}
+
+/// The sheet as a picture: each puff at the highest optical depth a sprite gets
+/// ([`super::shading::MAX_SPRITE_OPTICAL_DEPTH`]), white over a sky blue, `scale` pixels per
+/// texel (for documentation and for judging the puffs by eye).
+pub fn puff_sheet_preview(scale: u32) -> crate::image::LdrImage {
+    const SKY: [f32; 3] = [70.0, 120.0, 190.0];
+    let sheet = sheet();
+    let tau = super::shading::MAX_SPRITE_OPTICAL_DEPTH;
+    let side = SHEET_TEXELS * scale.max(1);
+    let pixels = (0..side * side)
+        .map(|i| {
+            let (x, y) = ((i % side) / scale.max(1), (i / side) / scale.max(1));
+            let c = f32::from(sheet[(y * SHEET_TEXELS + x) as usize]) / 255.0;
+            let alpha = 1.0 - (-tau * c).exp();
+            let [r, g, b] = SKY.map(|s| (s + (255.0 - s) * alpha).round() as u8);
+            [r, g, b, 255]
+        })
+        .collect();
+    crate::image::LdrImage {
+        width: side,
+        height: side,
+        pixels,
+    }
 }
 
 /// One puff: its family, its blobs (centre, standard deviation) and its noise seed.
@@ -313,7 +353,7 @@ mod tests {
     #[test]
     fn puffs_have_soft_rims_at_the_highest_optical_depth() {
         let sheet = bake_sheet();
-        let tau = super::super::cloud_set::MAX_SPRITE_OPTICAL_DEPTH;
+        let tau = super::super::shading::MAX_SPRITE_OPTICAL_DEPTH;
         for i in 0..16 {
             let step = sharpest_rim_step(&tile_of(&sheet, i), tau);
             assert!(step < 0.16, "tile {i}: opacity rises by {step} at its rim");
@@ -340,11 +380,4 @@ mod tests {
         assert_eq!(texture_in(SOLID, 0.0), 0);
         assert_eq!(texture_in(SOLID, 0.999), 7);
     }
-}
-#[test]
-fn dump_sheet_tmp() {
-    let s = bake_sheet();
-    let mut out = format!("P5 {} {} 255\n", SHEET_TEXELS, SHEET_TEXELS).into_bytes();
-    out.extend(s);
-    std::fs::write("/tmp/sheet.pgm", out).unwrap();
 }

@@ -53,6 +53,9 @@ pub struct Recipe {
     pub opacity: f32,
     /// Sprites a shading group holds at most (Wang: 1-30).
     pub group_size: u32,
+    /// A sheet (stratus, altostratus, nimbostratus): field sprites are sized by how far apart
+    /// they lie across the deck, not by its thin height, so that they overlap into a veil.
+    pub sheet: bool,
 }
 
 impl CloudType {
@@ -73,6 +76,7 @@ impl CloudType {
             taper: 0.7,
             opacity: 1.0,
             group_size: 12,
+            sheet: false,
         };
         match self {
             FairWeather => Recipe {
@@ -123,6 +127,7 @@ impl CloudType {
                 rotation_deg: (-15.0, 15.0),
                 textures: BLURRY,
                 opacity: 0.7,
+                sheet: true,
                 ..base
             },
             Altocumulus => Recipe {
@@ -143,6 +148,7 @@ impl CloudType {
                 rotation_deg: (-10.0, 10.0),
                 textures: WISPY | BLURRY,
                 opacity: 0.55,
+                sheet: true,
                 ..base
             },
             Nimbostratus => Recipe {
@@ -154,6 +160,7 @@ impl CloudType {
                 rotation_deg: (-30.0, 30.0),
                 textures: BLURRY,
                 cull_fraction: CULL_FRACTION_DENSE,
+                sheet: true,
                 ..base
             },
         }
