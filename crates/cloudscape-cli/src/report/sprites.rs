@@ -53,11 +53,14 @@ pub fn markdown<'a>(s: &mut String, rows: impl Iterator<Item = (&'a str, &'a Opt
         s,
         "\n## Sprites\n\n\
          The sprite technique (`render.technique = \"sprites\"`, Wang 2003) on the same scenes, \
-         against the same path-traced field. Its clouds are the field's (clusters of textured \
-         sprites in wind-borne tiles, opacity ramping with the field's density) and hand-made or \
-         model-file clouds; its shading is Wang's artist model with physically derived numbers \
-         (`docs/sprites.md`). It draws no voxel grids: the voxel scene shows none, and is not measured.\n\n\
-         The first frame's wall time includes making the field's sprite clouds on the CPU.\n\n\
+         against the same path-traced field. Its clouds are the field's (clusters of soft textured \
+         sprites in wind-borne tiles, each as opaque as the matter of its cell, lit from the light \
+         volume and the cloud shadow map) and hand-made or model-file clouds (Wang's artist model \
+         with physically derived numbers; `docs/sprites.md`). It draws no voxel grids: the voxel \
+         scene shows none, and is not measured.\n\n\
+         The first frame's wall time includes making the field's sprite clouds (the tiles' drafts on \
+         the CPU, the field's density at every candidate read on the GPU) and the light volume's \
+         first solve; `cloudscape bench` times the build alone (\"first frame's prepare\").\n\n\
          | scene | sprites drawn | HDR-FLIP | relMSE | luminance ratio | first frame ms |\n\
          |---|---|---|---|---|---|"
     );

@@ -6,13 +6,15 @@
 //! becomes one cloud:
 //!
 //! 1. Candidate centres fill the tile over the band where the tile's cloud type can have cloud
-//!    (its height profile), and Wang 2003's cull thins them to one per cull radius. None of this
-//!    depends on coverage, so a sequence whose coverage changes keeps every sprite in place.
-//! 2. Each candidate reads the coarse field (weather, height profile, base noise: the density the
-//!    ray marcher's light paths read) at its centre. Where it is clear, the sprite is dropped;
-//!    elsewhere its opacity ramps up with the density. As coverage grows, the densest cores pass
-//!    the threshold first and the edges last, so clouds form from the core and dissipate from the
-//!    edges (Wang 2003, "Animation"), as the field's clouds do.
+//!    (its height profile), and Wang 2003's cull thins them to one per cull radius: the tile's
+//!    [`TileDraft`]. None of this depends on coverage, so a sequence whose coverage changes keeps
+//!    every sprite in place, and an edit of coverage keeps the drafts.
+//! 2. The coarse field (weather, height profile, base noise: the density the ray marcher's light
+//!    paths read) is read at every candidate of every new tile at once, by a
+//!    [`CoarseFieldReader`] (the GPU in a frame). Where it is clear, the sprite is dropped;
+//!    elsewhere it is as opaque as the matter of its cell. As coverage grows, the densest cores
+//!    appear first and the edges last, so clouds form from the core and dissipate from the edges
+//!    (Wang 2003, "Animation"), as the field's clouds do.
 //! 3. The cloud's boxes are the columns of a 3 x 3 split of the tile, each from its lowest sprite
 //!    bottom to its highest top: a footprint, base and top that follow the field.
 

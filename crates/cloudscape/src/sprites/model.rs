@@ -69,7 +69,9 @@ pub struct Sprite {
     pub texture: u32,
     /// The shading group it belongs to (an index into its cloud's groups).
     pub group: u32,
-    /// Opacity 0..1: the type's opacity times the cloud's presence here (formation).
+    /// Opacity 0..1: a hand-made sprite's share of its chord's optical depth (the type's
+    /// opacity); a field sprite's optical depth over the most a sprite gets (the matter of its
+    /// cell, `from_field.rs`).
     pub opacity: f32,
 }
 

@@ -12,7 +12,7 @@ struct Sprite {
     rotation_rad: f32,          // about the view axis
     texture: u32,               // tile of the puff sheet, 0..15
     cloud: u32,                 // index into `clouds`
-    optical_depth: f32,         // through its densest column: type opacity x presence x size
+    optical_depth: f32,         // through its densest column (cloud_set.rs)
     directional: f32,           // its shading group's directional factor, 0..1
     sun_transmittance: f32,     // direct sun reaching its group, 0..1 (silver lining)
 }
@@ -57,6 +57,7 @@ struct Varying {
     @location(1) diffuse: vec3<f32>,            // ambient + directional radiance
     @location(2) single: vec3<f32>,             // single-scattered sun (silver lining)
     @location(7) thin_only: f32,                // 1: the single-scattered sun lights only thin parts
+    @location(8) cos_sun: f32,                  // between the view ray and the direction to the sun
     @location(3) opacity: f32,                  // fades and the level's opacity
     @location(6) optical_depth: f32,            // the sprite's, through its densest column
     @location(4) distance_m: f32,
@@ -148,11 +149,27 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     out.diffuse = select(wang_diffuse, volume_diffuse, volume);
     out.single = select(wang_single, volume_single, volume);
     out.thin_only = select(1.0, 0.0, volume);
+    out.cos_sun = cos_sun;
     out.opacity = level.a * through * edge_on * far;
     out.optical_depth = s.optical_depth;
     out.distance_m = length(p - view.eye_m);
     out.soft_m = 0.25 * radius;
     return out;
+}
+
+// The sun's beam that a slab of optical depth `tau` scatters toward the eye, per unit of the beam's
+// scattering, once the slab's own matter has dimmed it on both legs: the sun enters the side
+// facing it, so a point at depth t from the eye's side is reached through
+// s(t) = tau (1 + c) / 2 - c t of the slab (the far side's depth when the sun is behind it, c = 1;
+// t when it is behind the eye, c = -1; half the slab from the side), and the light it scatters
+// leaves through t: the integral of exp(-t - s(t)) over [0, tau],
+// exp(-tau (1 + c) / 2) (1 - exp(-tau (1 - c))) / (1 - c). Thin slabs give tau, as
+// 1 - exp(-tau) does; a thick one against the sun only tau exp(-tau) (single scattering in a
+// homogeneous slab, Chandrasekhar 1960, ch. I).
+fn sprite_beam_weight(tau: f32, c: f32) -> f32 {
+    let k = 1.0 - c;
+    let inner = select((1.0 - exp(-tau * k)) / max(k, 1e-6), tau, k < 1e-4);
+    return exp(-0.5 * tau * (1.0 + c)) * inner;
 }
 
 @fragment
@@ -163,10 +180,14 @@ fn fs_sprite(in: Varying) -> SpriteTargets {
     let depth = textureLoad(host_depth, vec2<i32>(sprite_frame_pixel(texel)), 0).x;
     let fade = sprite_host_fade(depth, texel, in.distance_m, in.soft_m);
     // A select, not a branch on the uniform alone (sprite_max_colours says why).
-    let alpha = (1.0 - exp(-in.optical_depth * cover)) * in.opacity * select(1.0, fade, view.host_depth_test == 1u);
-    // Thin parts of a puff scatter the direct sun once toward the eye (premultiplied, E p tau ~
-    // E p alpha for thin matter); its thick core's light is the diffuse term's.
-    let thin = (1.0 - cover) * (1.0 - cover);
-    let radiance = alpha * (in.diffuse + mix(1.0, thin, in.thin_only) * in.single);
+    let visible = in.opacity * select(1.0, fade, view.host_depth_test == 1u);
+    let tau = in.optical_depth * cover;
+    let alpha = (1.0 - exp(-tau)) * visible;
+    // Wang's model: thin parts of a puff scatter the direct sun once toward the eye (premultiplied,
+    // E p tau ~ E p alpha for thin matter), its thick core's light is the diffuse term's. Lit from
+    // physics: the beam dimmed within the sprite on its way in and out.
+    let thin = alpha * (1.0 - cover) * (1.0 - cover);
+    let beam = sprite_beam_weight(tau, in.cos_sun) * visible;
+    let radiance = alpha * in.diffuse + mix(beam, thin, in.thin_only) * in.single;
     return sprite_targets(radiance, alpha, in.distance_m);
 }
