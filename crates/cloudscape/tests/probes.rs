@@ -1,9 +1,12 @@
 //! Every WGSL function with a CPU twin agrees with it on the GPU: the coarse field the light paths
-//! use, camera rays and depth in every convention, aerial perspective, the sun disc, the sky, the
-//! ground, the diffuse transmittance, phase functions, height profiles and tone mapping. Also: a live edit of the field reaches the
-//! GPU without regenerating the noise.
+//! use (and the sprites read in one batch), camera rays and depth in every convention, aerial
+//! perspective, the sun disc, the sky, the ground, the diffuse transmittance, phase functions,
+//! height profiles and tone mapping. Also: a live edit of the field reaches the GPU without
+//! regenerating the noise.
 
 use cloudscape::environment::{Environment, ViewedEnvironment};
+use cloudscape::field::read_gpu::FieldReadPass;
+use cloudscape::field::{CoarseFieldReader, CpuCoarseReader};
 use cloudscape::frame::{DepthConvention, Frame, FrameSettings};
 use cloudscape::gpu::GpuContext;
 use cloudscape::optics::{
@@ -115,6 +118,19 @@ fn coarse_field_and_its_light_paths_match_the_cpu() {
         p99 < 0.02 * layer.extinction_per_m,
         "coarse extinction p99 {p99}"
     );
+    // The sprites' batch reader: the same function in one dispatch, its CPU twin the field's.
+    let pass = FieldReadPass::new(&ctx, &clouds.shared());
+    let batch = pass
+        .reader(&ctx, clouds.shared())
+        .coarse_extinctions_per_m(&points);
+    for (b, g) in batch.iter().zip(&got) {
+        assert!((b - g.x).abs() <= 1e-6 * layer.extinction_per_m, "{b} {}", g.x);
+    }
+    let cpu = CpuCoarseReader {
+        field: &field,
+        time_s: 0.0,
+    };
+    assert_eq!(cpu.coarse_extinctions_per_m(&points), want);
 
     // Light paths: doubling segments toward the sun and uniform ones up from the ground.
     let sun = Environment::from_scene(&scene).sun.direction;

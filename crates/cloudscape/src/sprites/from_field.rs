@@ -342,7 +342,7 @@ fn column_boxes(cloud: &SpriteCloud, tile_m: f32) -> Vec<SpriteBox> {
 mod tests {
     use super::*;
     use crate::field::CpuCoarseReader;
-    use crate::scene::Scene;
+    use crate::scene::{Scene, SceneDocument};
     use std::path::Path;
 
     fn field(coverage: f32) -> CloudField {
@@ -437,6 +437,66 @@ mod tests {
         assert_eq!(
             TILING.tiles_around(&f, glam::Vec3::ZERO),
             later.tiles_around(&f, eye)
+        );
+    }
+
+    /// Each field sprite's puff holds the matter of its cell (`sigma V`, the extinction at its
+    /// centre times the volume each candidate stands for), and a sheet's sprites are wide enough
+    /// to overlap into a veil.
+    #[test]
+    fn field_sprites_hold_the_matter_of_their_cells_and_sheets_overlap() {
+        let mut scene = Scene::default();
+        scene.layers[0].coverage = 0.6;
+        let f = CloudField::new(&scene, Path::new(".")).unwrap();
+        let read = CpuCoarseReader {
+            field: &f,
+            time_s: 0.0,
+        };
+        let keys = TILING.tiles_around(&f, glam::Vec3::ZERO);
+        let mut checked = 0;
+        for key in keys.iter().take(6) {
+            let Some(draft) = TILING.draft(&f, *key) else {
+                continue;
+            };
+            let Some(cloud) = TILING.clouds(&f, &[*key], &read)[0].clone() else {
+                continue;
+            };
+            for s in cloud.sprites.iter().filter(|s| s.opacity < 1.0) {
+                let p = cloud.center_m + s.offset_m;
+                let held = s.opacity
+                    * MAX_SPRITE_OPTICAL_DEPTH
+                    * super::super::textures::mean_cover()
+                    * s.size_m.x
+                    * s.size_m.y;
+                let matter = f.coarse_extinction_per_m(p, 0.0) * draft.cell_m3;
+                assert!((held - matter).abs() <= 1e-3 * matter, "{held} vs {matter}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 50, "{checked}");
+
+        // A thin stratus deck: its sprites lie at least a quarter of their width apart.
+        let deck = SceneDocument::parse(
+            "[[layers]]\nbottom_m = 700.0\nthickness_m = 400.0\ncoverage = 0.97\n\
+             types = { stratus = 1.0 }\n",
+            "deck",
+            Path::new("."),
+            &[],
+        )
+        .unwrap()
+        .scene;
+        let f = CloudField::new(&deck, Path::new(".")).unwrap();
+        let read = CpuCoarseReader {
+            field: &f,
+            time_s: 0.0,
+        };
+        let key = TILING.tiles_around(&f, glam::Vec3::ZERO)[0];
+        let cloud = TILING.clouds(&f, &[key], &read)[0].clone().expect("a deck");
+        assert!(cloud.cloud_type.recipe().sheet);
+        let spacing = TILING.tile_m / (cloud.sprites.len() as f32).sqrt();
+        assert!(
+            cloud.sprites.iter().all(|s| s.size_m.x >= 3.99 * spacing),
+            "{spacing}"
         );
     }
 }
