@@ -124,7 +124,11 @@ fn coarse_field_and_its_light_paths_match_the_cpu() {
         .reader(&ctx, clouds.shared())
         .coarse_extinctions_per_m(&points);
     for (b, g) in batch.iter().zip(&got) {
-        assert!((b - g.x).abs() <= 1e-6 * layer.extinction_per_m, "{b} {}", g.x);
+        assert!(
+            (b - g.x).abs() <= 1e-6 * layer.extinction_per_m,
+            "{b} {}",
+            g.x
+        );
     }
     let cpu = CpuCoarseReader {
         field: &field,

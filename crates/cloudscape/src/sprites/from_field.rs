@@ -128,6 +128,8 @@ impl FieldTiling {
             })
             .collect();
         let extinctions = reader.coarse_extinctions_per_m(&points);
+        // Baked here, outside the parallel loop: a lazy bake inside it would wait on itself.
+        let cover = super::textures::mean_cover();
         let mut at = 0;
         let mut read = Vec::with_capacity(drafts.len());
         for draft in drafts {
@@ -141,7 +143,7 @@ impl FieldTiling {
             .map(|r| {
                 let (draft, span) = r?;
                 let layer = &field.layers[draft.layer as usize];
-                draft.finish(&extinctions[span], layer.extinction_per_m)
+                draft.finish(&extinctions[span], layer.extinction_per_m, cover)
             })
             .collect()
     }
@@ -196,13 +198,14 @@ impl FieldTiling {
 }
 
 /// A field sprite's opacity: the optical depth its puff needs to hold the matter of its cell,
-/// `cell_m3` of cloud of extinction `extinction_per_m`, over [`MAX_SPRITE_OPTICAL_DEPTH`] (a field
+/// `cell_m3` of cloud of extinction `extinction_per_m` (puffs of mean cover `cover`,
+/// [`super::textures::mean_cover`]), over [`MAX_SPRITE_OPTICAL_DEPTH`] (a field
 /// sprite's optical depth is its opacity times that). The puff's optical depth integrated over its
 /// quad, `tau m w h` (`m` the puffs' mean normalised column density), equals the cell's `sigma V`:
 /// summed over overlapping sprites, a view through the cloud meets the field's optical depth,
 /// however many sprites stand for it, up to the soft-rim bound on each sprite.
-fn mass_opacity(extinction_per_m: f32, cell_m3: f32, size_m: Vec2) -> f32 {
-    let tau = extinction_per_m * cell_m3 / (super::textures::mean_cover() * size_m.x * size_m.y);
+fn mass_opacity(extinction_per_m: f32, (cell_m3, cover): (f32, f32), size_m: Vec2) -> f32 {
+    let tau = extinction_per_m * cell_m3 / (cover * size_m.x * size_m.y);
     (tau / MAX_SPRITE_OPTICAL_DEPTH).clamp(0.0, 1.0)
 }
 
@@ -246,12 +249,13 @@ pub struct TileDraft {
 impl TileDraft {
     /// The cloud of the candidates where the field is cloudy (`extinctions_per_m`, one per
     /// candidate, of a layer whose densest extinction is `layer_extinction_per_m`), each sprite
-    /// wide enough to overlap its neighbours and as opaque as the matter of its cell; None where
-    /// the tile is clear.
+    /// wide enough to overlap its neighbours and as opaque as the matter of its cell (puffs of
+    /// mean cover `cover`); None where the tile is clear.
     fn finish(
         &self,
         extinctions_per_m: &[f32],
         layer_extinction_per_m: f32,
+        cover: f32,
     ) -> Option<SpriteCloud> {
         let recipe = self.cloud_type.recipe();
         let present: Vec<(usize, Vec3, f32)> = self
@@ -269,7 +273,7 @@ impl TileDraft {
                 let offset = p - self.centre_m;
                 let mut s = dress(&recipe, self.seed, k as u32, offset, self.height_m);
                 s.size_m *= (least_width_m / s.size_m.x).max(1.0);
-                s.opacity = mass_opacity(extinction, self.cell_m3, s.size_m);
+                s.opacity = mass_opacity(extinction, (self.cell_m3, cover), s.size_m);
                 s
             })
             .collect();
@@ -454,14 +458,14 @@ mod tests {
         };
         let keys = TILING.tiles_around(&f, glam::Vec3::ZERO);
         let mut checked = 0;
-        for key in keys.iter().take(6) {
+        for key in keys.iter().take(12) {
             let Some(draft) = TILING.draft(&f, *key) else {
                 continue;
             };
             let Some(cloud) = TILING.clouds(&f, &[*key], &read)[0].clone() else {
                 continue;
             };
-            for s in cloud.sprites.iter().filter(|s| s.opacity < 1.0) {
+            for s in &cloud.sprites {
                 let p = cloud.center_m + s.offset_m;
                 let held = s.opacity
                     * MAX_SPRITE_OPTICAL_DEPTH
@@ -469,11 +473,15 @@ mod tests {
                     * s.size_m.x
                     * s.size_m.y;
                 let matter = f.coarse_extinction_per_m(p, 0.0) * draft.cell_m3;
-                assert!((held - matter).abs() <= 1e-3 * matter, "{held} vs {matter}");
-                checked += 1;
+                // A sprite at the soft-rim bound holds less; every other one holds its matter.
+                assert!(held <= matter * 1.001, "{held} vs {matter}");
+                if s.opacity < 1.0 {
+                    assert!((held - matter).abs() <= 1e-3 * matter, "{held} vs {matter}");
+                    checked += 1;
+                }
             }
         }
-        assert!(checked > 50, "{checked}");
+        assert!(checked > 25, "{checked}");
 
         // A thin stratus deck: its sprites lie at least a quarter of their width apart.
         let deck = SceneDocument::parse(
