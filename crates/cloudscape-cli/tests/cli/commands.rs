@@ -194,6 +194,9 @@ fn bench_json_reports_each_pass_and_the_frame_wall_time() {
                 "display",
             ],
             (Some(true), "sprites") => &[
+                "light volume cells",
+                "light volume solve",
+                "light volume table",
                 "sprites: impostors",
                 "sprites: draw",
                 "sprites: resolve",
@@ -216,7 +219,7 @@ fn bench_json_reports_each_pass_and_the_frame_wall_time() {
         };
         // Every technique's frame starts with the environment's passes: the shadow map, the sky's
         // static tables (in the first frame: no warm-up here) and its per-frame ones (then the
-        // light volume's, for the ray marcher and the particles, which read it).
+        // light volume's: every technique reads it).
         let environment = [
             "cloud shadow map",
             "sky: transmittance table",
@@ -235,6 +238,13 @@ fn bench_json_reports_each_pass_and_the_frame_wall_time() {
             .as_f64()
             .expect("frame_wall.mean_ms");
         assert!(wall_ms > 0.0, "{report}");
+        // The technique's CPU time per frame, and the first frame's, where the sprites build.
+        let prepare = report["prepare_cpu"]["median_ms"].as_f64();
+        let first = report["first_prepare_cpu_ms"]
+            .as_f64()
+            .expect("first prepare");
+        assert!(prepare.is_some_and(|ms| ms >= 0.0), "{report}");
+        assert!(technique != "sprites" || first > 0.0, "{report}");
     }
     assert!(reports[0]["primitives"].is_null());
     assert!(reports[1]["primitives"].as_u64().is_some_and(|n| n > 1000));

@@ -379,5 +379,7 @@ fn environment_light_volume_ground_irradiance(g: vec3<f32>) -> vec3<f32> {
             left *= 1.0 - w;
         }
     }
-    return select(vec3<f32>(0.0), irradiance, environment_has_light_volume());
+    // Irradiance is never negative; the diffusion solution's flux out of the bottom can be where
+    // the P1 approximation fails (thin, dark clouds).
+    return select(vec3<f32>(0.0), max(irradiance, vec3<f32>(0.0)), environment_has_light_volume());
 }

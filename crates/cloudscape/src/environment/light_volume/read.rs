@@ -65,7 +65,8 @@ impl LightVolume {
     /// leaves the grid's bottom face there ([`Diffusion::bottom_irradiance`], bilinear between the
     /// columns' centres) (`environment_light_volume_ground_irradiance`). Under a clear sky it is
     /// the sky's irradiance less what the clear column holds back; under a deck, what the deck
-    /// passes on and sends back of the ground's own light. None without a volume.
+    /// passes on and sends back of the ground's own light; never negative (the diffusion
+    /// solution's flux can be, where the P1 approximation fails). None without a volume.
     pub fn ground_irradiance(&self, g: Vec3) -> Option<Vec3> {
         self.enabled.then(|| {
             self.blend_cascades(g, |(problem, solution)| {
@@ -79,6 +80,7 @@ impl LightVolume {
                 }
                 [sum, Vec3::ZERO]
             })[0]
+                .max(Vec3::ZERO)
         })
     }
 
