@@ -131,7 +131,7 @@ fn coarse_field_and_its_light_paths_match_the_cpu() {
         );
     }
     let cpu = CpuCoarseReader {
-        field: &field,
+        field,
         time_s: 0.0,
     };
     assert_eq!(cpu.coarse_extinctions_per_m(&points), want);
