@@ -130,10 +130,7 @@ fn coarse_field_and_its_light_paths_match_the_cpu() {
             g.x
         );
     }
-    let cpu = CpuCoarseReader {
-        field,
-        time_s: 0.0,
-    };
+    let cpu = CpuCoarseReader { field, time_s: 0.0 };
     assert_eq!(cpu.coarse_extinctions_per_m(&points), want);
 
     // Light paths: doubling segments toward the sun and uniform ones up from the ground.

@@ -232,12 +232,7 @@ impl ParticleRenderer {
             ],
             ambient_scale: scene.lighting.ambient_scale,
             diffuse_from_volume: u32::from(scene.lighting.model == LightingModel::Volume),
-            slab_params: Vec4::from_array(
-                scene
-                    .lighting
-                    .sun_slab(PhaseLobes::from_scene(&scene.phase))
-                    .params_to_gpu(),
-            ),
+            slab_params: Vec4::from_array(scene.sun_slab().params_to_gpu()),
             ..RenderUniform::zeroed()
         }
     }

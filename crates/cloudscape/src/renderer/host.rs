@@ -22,7 +22,6 @@ use crate::field::{CloudField, FieldError};
 use crate::frame::{Frame, FrameGpu, FrameSettings};
 use crate::gpu::pipeline::{STORAGE_OUTPUT, texture_2d};
 use crate::gpu::{GpuContext, PassTimer};
-use crate::optics::PhaseLobes;
 use crate::output::{CloudOutput, SampleGrid};
 use crate::pass::Shared;
 use crate::post::upsample::Upsampler;
@@ -415,7 +414,7 @@ impl CloudRenderer {
     /// The frame's light volume as the environment's uniform holds it.
     fn light_volume_uniform(&self) -> LightVolumeUniform {
         let s = &self.settings;
-        let optics = DiffuseOptics::of(&s.lighting.sun_slab(PhaseLobes::from_scene(&s.phase)));
+        let optics = DiffuseOptics::of(&s.sun_slab());
         let volume = self.light_volume.as_ref();
         LightVolumeUniform::new(
             volume.map(|(grid, settings, _)| (grid, optics, settings.beam_steps)),

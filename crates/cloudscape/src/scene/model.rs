@@ -588,6 +588,15 @@ pub struct Lighting {
     pub volume_beam_steps: u32,
 }
 
+impl Scene {
+    /// The slab model of the scene's lighting and phase function: what every technique's sun beam
+    /// (the forward peak) and the light volume's optics follow.
+    pub fn sun_slab(&self) -> crate::optics::SunSlab {
+        self.lighting
+            .sun_slab(crate::optics::PhaseLobes::from_scene(&self.phase))
+    }
+}
+
 impl Lighting {
     /// The slab model these settings describe for `lobes`.
     pub fn sun_slab(&self, lobes: crate::optics::PhaseLobes) -> crate::optics::SunSlab {

@@ -648,12 +648,7 @@ impl Technique for SpriteRenderer {
                 phase_lobes: Vec4::from_array(PhaseLobes::from_scene(&scene.phase).to_gpu()),
                 albedo: scene.lighting.albedo,
                 lit_by_volume: u32::from(scene.lighting.model == LightingModel::Volume),
-                slab_params: Vec4::from_array(
-                    scene
-                        .lighting
-                        .sun_slab(PhaseLobes::from_scene(&scene.phase))
-                        .params_to_gpu(),
-                ),
+                slab_params: Vec4::from_array(scene.sun_slab().params_to_gpu()),
                 ..SettingsUniform::zeroed()
             },
         });
