@@ -202,8 +202,8 @@ impl CloudSet {
                 .filter(|k| !self.tiles.contains_key(k))
                 .collect();
             changed |= self.tiles.len() != before || !missing.is_empty();
-            let drafts: Vec<Option<TileDraft>> =
-                missing.iter().map(|k| self.drafts[k].clone()).collect();
+            let drafts: Vec<Option<&TileDraft>> =
+                missing.iter().map(|k| self.drafts[k].as_ref()).collect();
             let made = tiling.finish(field, &drafts, reader);
             self.tiles.extend(missing.into_iter().zip(made));
         }

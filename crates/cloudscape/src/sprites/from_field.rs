@@ -108,6 +108,7 @@ impl FieldTiling {
     ) -> Vec<Option<SpriteCloud>> {
         let drafts: Vec<Option<TileDraft>> =
             keys.par_iter().map(|&key| self.draft(field, key)).collect();
+        let drafts: Vec<Option<&TileDraft>> = drafts.iter().map(Option::as_ref).collect();
         self.finish(field, &drafts, reader)
     }
 
@@ -116,7 +117,7 @@ impl FieldTiling {
     pub fn finish(
         &self,
         field: &CloudField,
-        drafts: &[Option<TileDraft>],
+        drafts: &[Option<&TileDraft>],
         reader: &dyn CoarseFieldReader,
     ) -> Vec<Option<SpriteCloud>> {
         let points: Vec<Vec3> = drafts
@@ -133,7 +134,7 @@ impl FieldTiling {
         let mut at = 0;
         let mut read = Vec::with_capacity(drafts.len());
         for draft in drafts {
-            read.push(draft.as_ref().map(|d| {
+            read.push(draft.map(|d| {
                 let span = at..at + d.points_m.len();
                 at = span.end;
                 (d, span)
