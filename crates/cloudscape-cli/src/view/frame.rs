@@ -10,7 +10,7 @@ use cloudscape::frame::{Frame, FrameSun};
 use cloudscape::image::LdrImage;
 use cloudscape::renderer::{EmptyHost, Reuse};
 use cloudscape::scene::Scene;
-use cloudscape::shadow::ShadowReuse;
+use cloudscape::shadow::LightingReuse;
 use glam::UVec2;
 
 use super::panel::{Measured, PanelInputs, PanelOutput, Request};
@@ -20,8 +20,8 @@ use super::viewer::{MAX_FRAME_S, SCRIPTED_FRAME_S, Viewer};
 /// How far the eye and the clouds may move before the shadow map is built again: half of its
 /// finest texel (about 120 m under the eye in the default scene), a lag of the clouds' shadows no
 /// one sees, for a pass that costs more than the rest of the frame on a software adapter.
-const SHADOW_REUSE: ShadowReuse = ShadowReuse {
-    max_drift_texels: 0.5,
+const LIGHTING_REUSE: LightingReuse = LightingReuse {
+    max_shadow_drift_texels: 0.5,
 };
 
 /// The panels' output of one frame, ready to draw.
@@ -202,11 +202,11 @@ impl Viewer {
     fn draw(&mut self, surface: &wgpu::SurfaceTexture, ui: &Ui) {
         // Without temporal reuse a frame is a still, as `cloudscape render` draws it; with it, the
         // index advances the jitter every frame, and the shadow map is kept while it serves.
-        let (frame_index, shadow_reuse) = match self.view.temporal {
-            Some(_) => (self.frame_index as u32, Some(SHADOW_REUSE)),
+        let (frame_index, lighting_reuse) = match self.view.temporal {
+            Some(_) => (self.frame_index as u32, Some(LIGHTING_REUSE)),
             None => (0, None),
         };
-        self.clouds.set_shadow_reuse(shadow_reuse);
+        self.clouds.set_lighting_reuse(lighting_reuse);
         let frame = self.view_frame(frame_index);
         if self.host.as_ref().is_none_or(|h| !h.fits(&frame)) {
             self.host = Some(EmptyHost::new(&self.ctx, &frame));

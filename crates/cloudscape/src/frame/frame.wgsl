@@ -14,11 +14,10 @@ struct Frame {
     frame_index: u32,               // decorrelates the jitter of successive frames
     grid_subpixel: vec2<u32>,       // the pixel of each divisor x divisor block the output samples
     grid_divisor: u32,              // 1, 2 or 4: output resolution is 1/divisor of the viewport
-    ray_offset_strata: f32,         // this frame's Halton offset along the rays, in strata
     depth_far_value: f32,           // the host depth-buffer value where there is no geometry
     depth_reversed: u32,            // 1 when nearer geometry stores larger depth values
     cloud_mean_cosine: f32,         // mean cosine g of the cloud droplets' phase function
-    temporal_ray_offsets: u32,      // 1: ray offsets are Halton + Bayer (temporal reuse); 0: white noise
+    reserved: vec2<u32>,
 }
 
 @group(1) @binding(0) var<uniform> frame: Frame;
@@ -86,10 +85,17 @@ fn frame_depth_distance(pixel: vec2<f32>, depth: f32) -> f32 {
     return length(frame_view_point(pixel, depth));
 }
 
-// A per-pixel, per-frame value in [0, 1): white noise from the PCG hash (noise.wgsl), which turns
-// step banding into grain without the visible pattern of structured dithers at low sample counts.
-fn frame_pixel_jitter(pixel: vec2<u32>, index: u32) -> f32 {
-    return noise_hash_to_unit(noise_pcg_hash(pixel.x ^ noise_pcg_hash(pixel.y ^ noise_pcg_hash(index))));
+// A per-pixel, per-frame value in [0, 1) whose error averages away in space and in time: the R2
+// sequence over the pixels (Roberts 2018, "The unreasonable effectiveness of quasirandom
+// sequences": fract(x / g + y / g^2) for the plastic number g, a dither whose spectrum is
+// blue-noise-like, so neighbouring pixels' offsets cover the unit interval evenly and a 3x3
+// neighbourhood spans it) plus the golden-ratio R1 sequence over frames, so each pixel's offsets
+// stratify the interval in time. White noise (the PCG hash) left grain that neither the eye nor a
+// temporal history averages as fast.
+fn frame_blue_noise(pixel: vec2<u32>, index: u32) -> f32 {
+    let p = vec2<f32>(pixel % vec2<u32>(4096u));
+    let spatial = fract(p.x * FRAME_FOOTPRINT_STEP_X + p.y * FRAME_FOOTPRINT_STEP_Y);
+    return fract(spatial + f32(index % 4096u) * FRAME_OFFSET_STEP);
 }
 
 // Eddington (two-stream) diffuse transmittance of a conservatively scattering slab of optical depth

@@ -22,11 +22,10 @@ pub struct FrameUniform {
     frame_index: u32,
     grid_subpixel: UVec2,
     grid_divisor: u32,
-    ray_offset_strata: f32,
     depth_far_value: f32,
     depth_reversed: u32,
     cloud_mean_cosine: f32,
-    temporal_ray_offsets: u32,
+    reserved: UVec2,
 }
 
 impl FrameUniform {
@@ -46,11 +45,10 @@ impl FrameUniform {
             frame_index: frame.frame_index,
             grid_subpixel: grid.subpixel,
             grid_divisor: grid.divisor,
-            ray_offset_strata: grid.temporal_offset.unwrap_or(0.0),
             depth_far_value: frame.depth.far_value(),
             depth_reversed: frame.depth.is_reversed() as u32,
             cloud_mean_cosine: settings.cloud_mean_cosine,
-            temporal_ray_offsets: grid.temporal_offset.is_some() as u32,
+            reserved: UVec2::ZERO,
         }
     }
 }
@@ -68,8 +66,9 @@ pub static FRAME_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
     frame_constants
 );
 
-/// The frame's constants as WGSL: the step of the footprint's R2 sequence
-/// ([`super::FOOTPRINT_STEP`]).
+/// The frame's constants as WGSL: the step of the R2 sequence ([`super::FOOTPRINT_STEP`]) of the
+/// footprint and of the pixels' ray offsets, and the golden-ratio step of the offsets over frames
+/// ([`super::FRAME_OFFSET_STEP`]).
 fn frame_constants() -> String {
     use crate::shader::WgslConst::F32;
     crate::shader::wgsl_consts([
@@ -81,6 +80,7 @@ fn frame_constants() -> String {
             "FRAME_FOOTPRINT_STEP_Y",
             F32(super::FOOTPRINT_STEP[1] as f32),
         ),
+        ("FRAME_OFFSET_STEP", F32(super::FRAME_OFFSET_STEP as f32)),
     ])
 }
 
@@ -117,11 +117,10 @@ mod tests {
                 frame_index,
                 grid_subpixel,
                 grid_divisor,
-                ray_offset_strata,
                 depth_far_value,
                 depth_reversed,
                 cloud_mean_cosine,
-                temporal_ray_offsets,
+                reserved,
             }
         );
     }

@@ -22,6 +22,10 @@ use glam::{Mat4, UVec2, Vec2, Vec3};
 /// number `g = 1.3247...`, the real root of `x^3 = x + 1` (Roberts 2018).
 pub const FOOTPRINT_STEP: [f64; 2] = [0.754_877_666_246_692_7, 0.569_840_290_998_053_3];
 
+/// Step of the ray offsets from one frame to the next: `1/phi` for the golden ratio `phi`, the R1
+/// sequence, the most even additive recurrence in one dimension (Roberts 2018).
+pub const FRAME_OFFSET_STEP: f64 = 0.618_033_988_749_894_9;
+
 /// Normalised device depth of the point `camera_ray` and `frame_ray_direction` unproject to find a
 /// pixel's ray: between the near and far planes in every [`DepthConvention`].
 const RAY_NDC_DEPTH: f32 = 0.5;

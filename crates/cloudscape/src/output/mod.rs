@@ -28,8 +28,6 @@ pub struct SampleGrid {
     pub divisor: u32,
     /// The pixel of each divisor x divisor block the rays go through.
     pub subpixel: UVec2,
-    /// Offset along the rays in strata, for temporal reuse; None for independent white noise.
-    pub temporal_offset: Option<f32>,
 }
 
 impl SampleGrid {
@@ -37,7 +35,6 @@ impl SampleGrid {
     pub const FULL: SampleGrid = SampleGrid {
         divisor: 1,
         subpixel: UVec2::ZERO,
-        temporal_offset: None,
     };
 
     /// Grid size for a frame of `size` pixels.

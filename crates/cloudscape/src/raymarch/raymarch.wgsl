@@ -198,17 +198,12 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
     return MarchResult(radiance, transmittance, samples, distance_m);
 }
 
-// The seed's 3x3 Bayer matrix (volumecloud-implementation-detail): per-pixel ray offsets in ninths.
-const MARCH_BAYER_3X3 = array<f32, 9>(0.0, 7.0, 3.0, 6.0, 5.0, 2.0, 4.0, 1.0, 8.0);
-
-// Offset of the samples along the ray, in strata: for stills, white noise per pixel; for temporal
-// reuse, the frame's Halton value plus the pixel's Bayer offset, fract(halton + bayer / 9), so that
-// each 3x3 neighbourhood spans the stratum (the seed's fix for AABB clipping of undersampled rays).
+// Offset of the samples along the ray of output texel `px`, in strata: spatiotemporal blue noise
+// (frame_blue_noise), so that each 3x3 neighbourhood spans the stratum (the seed's Bayer offsets
+// serve AABB clipping of undersampled rays the same way) and each texel's offsets spread over
+// the stratum from frame to frame. The light samples take the same offset.
 fn march_ray_offset(px: vec2<u32>) -> f32 {
-    if frame.temporal_ray_offsets == 0u {
-        return frame_pixel_jitter(px, frame.frame_index);
-    }
-    return fract(frame.ray_offset_strata + MARCH_BAYER_3X3[(px.x % 3u) * 3u + px.y % 3u] / 9.0);
+    return frame_blue_noise(px, frame.frame_index);
 }
 
 // One sample of one ray per texel of the output grid (1/divisor of the frame's resolution), through

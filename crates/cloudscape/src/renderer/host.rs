@@ -27,7 +27,7 @@ use crate::pass::Shared;
 use crate::post::upsample::Upsampler;
 use crate::post::{Background, Compositor, DISPLAY_FORMAT, Display, HDR_FORMAT};
 use crate::scene::Scene;
-use crate::shadow::{BuiltShadow, ShadowParams, ShadowReuse};
+use crate::shadow::{BuiltShadow, LightingReuse, ShadowParams};
 use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use crate::temporal::{TemporalResolve, TemporalSettings};
 use glam::{UVec2, Vec2};
@@ -138,7 +138,7 @@ pub struct CloudRenderer {
     reuse: Reuse,
     /// Whether the shadow map may be kept across frames, what the current one was built for, and
     /// whether this frame builds it.
-    shadow_reuse: Option<ShadowReuse>,
+    lighting_reuse: Option<LightingReuse>,
     shadow_built: Option<BuiltShadow>,
     shadow_rebuild: bool,
     /// The light volume of the frame begun, when the technique reads one, and whether it may start
@@ -190,7 +190,7 @@ impl CloudRenderer {
             targets: None,
             frame: None,
             reuse: Reuse::None,
-            shadow_reuse: None,
+            lighting_reuse: None,
             shadow_built: None,
             shadow_rebuild: true,
             light_volume: None,
@@ -335,7 +335,6 @@ impl CloudRenderer {
                 SampleGrid {
                     divisor,
                     subpixel: UVec2::splat((divisor - 1) / 2),
-                    temporal_offset: None,
                 }
             }
         };
@@ -355,10 +354,17 @@ impl CloudRenderer {
         let shadow = self.frame_shadow(&env, frame);
         self.environment_gpu
             .resize(ctx, TableSizes::from_scene(&self.settings));
+        let warm = matches!(reuse, Reuse::Temporal(_)) || self.lighting_reuse.is_some();
+        let kept = self
+            .light_volume
+            .take()
+            .filter(|_| warm)
+            .map(|(grid, ..)| grid);
         self.light_volume = self.technique.reads_light_volume().then(|| {
             let settings = LightVolumeSettings::from_scene(&self.settings);
-            let grid = LightVolumeGrid::new(&settings, &self.field, frame.camera_position_m);
-            (grid, settings, matches!(reuse, Reuse::Temporal(_)))
+            let fresh = LightVolumeGrid::new(&settings, &self.field, frame.camera_position_m);
+            let grid = kept.filter(|k| k.still_serves(&fresh)).unwrap_or(fresh);
+            (grid, settings, warm)
         });
         let uniform = EnvironmentUniform::new(&env, frame.camera_position_m, &shadow)
             .with_light_volume(self.light_volume_uniform());
@@ -389,7 +395,7 @@ impl CloudRenderer {
         self.prepare_time
     }
 
-    /// The shadow map this frame reads: the one built before, when [`ShadowReuse`] allows it,
+    /// The shadow map this frame reads: the one built before, when [`LightingReuse`] allows it,
     /// else a new one (and the frame's environment passes build it).
     fn frame_shadow(&mut self, env: &Environment, frame: &Frame) -> ShadowParams {
         let sun = env.sun.direction;
@@ -401,7 +407,7 @@ impl CloudRenderer {
             time_s: frame.time_s,
         };
         let wind = self.wind_m_per_s();
-        let kept = match (self.shadow_reuse, &self.shadow_built) {
+        let kept = match (self.lighting_reuse, &self.shadow_built) {
             (Some(reuse), Some(built)) if built.serves(&fresh, wind, reuse) => Some(*built),
             _ => None,
         };
@@ -429,10 +435,11 @@ impl CloudRenderer {
             .map_or(Vec2::ZERO, |l| l.wind_m_per_s)
     }
 
-    /// Lets the clouds' shadow map be reused across frames (see [`ShadowReuse`]), or, with None,
-    /// rebuilt every frame (the default, as offline renders need).
-    pub fn set_shadow_reuse(&mut self, reuse: Option<ShadowReuse>) {
-        self.shadow_reuse = reuse;
+    /// Lets the lighting (the clouds' shadow map, the light volume's solve) be carried across
+    /// frames (see [`LightingReuse`]), or, with None, made afresh every frame (the default, as
+    /// offline renders need; temporal reuse warm-starts the light volume either way).
+    pub fn set_lighting_reuse(&mut self, reuse: Option<LightingReuse>) {
+        self.lighting_reuse = reuse;
     }
 
     /// Records the technique over output texels `region` (origin, size; None for all of them),

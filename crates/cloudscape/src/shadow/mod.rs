@@ -164,15 +164,17 @@ impl ShadowParams {
     }
 }
 
-/// Lowest and highest world heights of the field's clouds at the origin, and whether it has any.
-/// Reuse of the map across frames, for a real-time host: the map is built once and read until the
-/// eye or the clouds have moved too far, the sun has moved or the map's settings changed. Between
-/// builds the shadows lag the clouds by at most the drift allowed.
+/// Reuse of the lighting across frames, for a real-time host. The shadow map is built once and read
+/// until the eye or the clouds have moved too far, the sun has moved or the map's settings changed;
+/// between builds the shadows lag the clouds by at most the drift allowed. The light volume's solve
+/// starts from the last frame's solution (the scene's `lighting.volume_warm_sweeps` sweeps a frame)
+/// and its grid is recentred only once the eye has moved
+/// [`crate::environment::light_volume::RECENTRE_CELLS`] cells.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ShadowReuse {
+pub struct LightingReuse {
     /// The map is rebuilt once its centre (under the eye) and the clouds (with the wind) have
     /// moved, together, this many of its finest texels since it was built.
-    pub max_drift_texels: f32,
+    pub max_shadow_drift_texels: f32,
 }
 
 /// What a built map was built for.
@@ -192,7 +194,7 @@ impl BuiltShadow {
     /// Whether this map still serves a frame that would build `fresh` while the clouds move at
     /// `wind_m_per_s`: the same sun, size and settings, and its centre and the clouds within
     /// `reuse`'s drift.
-    pub fn serves(&self, fresh: &BuiltShadow, wind_m_per_s: Vec2, reuse: ShadowReuse) -> bool {
+    pub fn serves(&self, fresh: &BuiltShadow, wind_m_per_s: Vec2, reuse: LightingReuse) -> bool {
         let recentred = ShadowParams {
             centre_m: self.params.centre_m,
             ..fresh.params
@@ -202,10 +204,11 @@ impl BuiltShadow {
         }
         let eye_m = (fresh.params.centre_m - self.params.centre_m).length();
         let clouds_m = wind_m_per_s.length() * (fresh.time_s - self.time_s).abs();
-        eye_m + clouds_m <= reuse.max_drift_texels * self.params.finest_texel_m(self.texels)
+        eye_m + clouds_m <= reuse.max_shadow_drift_texels * self.params.finest_texel_m(self.texels)
     }
 }
 
+/// Lowest and highest world heights of the field's clouds at the origin, and whether it has any.
 pub(crate) fn cloud_heights(field: &CloudField) -> (f32, f32, bool) {
     let layers = field.altitude_range_m();
     let volumes = field

@@ -100,8 +100,8 @@ fn a_built_map_serves_until_the_eye_and_the_clouds_drift_too_far() {
         "{} {texel_m}",
         texel(128)
     );
-    let reuse = ShadowReuse {
-        max_drift_texels: 0.5,
+    let reuse = LightingReuse {
+        max_shadow_drift_texels: 0.5,
     };
     let wind = Vec2::new(6.0, 8.0);
     let served = |fresh: BuiltShadow| built.serves(&fresh, wind, reuse);

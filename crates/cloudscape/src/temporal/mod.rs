@@ -21,9 +21,11 @@ pub struct TemporalSettings {
     /// 1, 2 or 4: march one ray per divisor x divisor block per frame (4 updates 1/16 of the pixels,
     /// as Horizon Zero Dawn does).
     pub divisor: u32,
-    /// Weight of new samples per frame at full resolution (the seed's 0.05): pixels without a ray
-    /// of their own this frame blend toward the upsampled estimate by it, and a pixel that gets its
-    /// own ray every divisor^2 frames blends it in with the weight that decays as much over them.
+    /// Weight of new samples per frame at full resolution (the seed's 0.05): pixels far from this
+    /// frame's rays blend toward the interpolated estimate by it, and a ray's own pixel, which gets
+    /// a ray every divisor^2 frames, blends it in with the weight that decays as much over them;
+    /// between the two the weight falls off with the distance to the nearest ray
+    /// ([`RAY_SIGMA_PX`]).
     pub blend_per_frame: f32,
     /// Half-width of the neighbourhood box the history is clipped to, in standard deviations (the
     /// seed's gamma = 1).
@@ -59,7 +61,7 @@ pub const KNOBS: &[Knob<TemporalSettings>] = &[
 ];
 
 impl TemporalSettings {
-    /// Weight of a pixel's own fresh sample: 1 - (1 - blend)^(divisor^2).
+    /// Weight of a fresh sample at its ray's own pixel: 1 - (1 - blend)^(divisor^2).
     pub fn fresh_weight(&self) -> f32 {
         1.0 - (1.0 - self.blend_per_frame).powi((self.divisor * self.divisor) as i32)
     }
@@ -175,14 +177,14 @@ impl TemporalResolve {
         &self.settings
     }
 
-    /// The rays frame `frame_index` renders: its sub-pixel of each block (Bayer order) and its
-    /// Halton offset along the rays. The frame index must advance every frame.
+    /// The rays frame `frame_index` renders: its sub-pixel of each block (Bayer order); their
+    /// offsets along the rays follow the frame index (`frame_blue_noise`, `frame.wgsl`). The frame
+    /// index must advance every frame.
     pub fn grid(&self, frame_index: u32) -> SampleGrid {
         let divisor = self.settings.divisor;
         SampleGrid {
             divisor,
             subpixel: subpixel(frame_index, divisor),
-            temporal_offset: Some(halton(frame_index % 64 + 1, 3)),
         }
     }
 
@@ -289,8 +291,36 @@ pub static UPSAMPLE_WGSL: crate::shader::WgslModule =
 pub static TEMPORAL_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
     "temporal",
     "temporal.wgsl",
-    [&crate::frame::FRAME_WGSL, &UPSAMPLE_WGSL]
+    [&crate::frame::FRAME_WGSL, &UPSAMPLE_WGSL],
+    temporal_constants
 );
+
+/// Width (standard deviation, pixels) of the bump over which a new sample is blended into the
+/// history around its ray (`temporal_new_weight`): wide enough that no pixel lattice shows, narrow
+/// enough that a pixel between rays takes little of the interpolated estimate.
+pub const RAY_SIGMA_PX: f32 = 0.75;
+
+/// The bump's width where the camera's step has moved the history [`CLIP_MOTION_PX`] or more by
+/// parallax since the previous frame: such a history is clipped, and the estimate between rays is
+/// the better guess over more of the pixels around each ray.
+pub const MOVING_RAY_SIGMA_PX: f32 = 1.2;
+
+/// How far (pixels) the camera's step must have moved the history by parallax (against the far
+/// background) since the previous frame for it to be clipped to the current neighbourhood in
+/// full; less clips it in proportion. A still or turning view keeps its history as it is (its
+/// reprojection is exact), so features thinner than the grid's spacing, which this frame's rays
+/// miss, stay (clipping would keep them only at this frame's rays: the grid's pattern).
+pub const CLIP_MOTION_PX: f32 = 2.0;
+
+/// The resolve's constants as WGSL.
+fn temporal_constants() -> String {
+    use crate::shader::WgslConst::F32;
+    crate::shader::wgsl_consts([
+        ("TEMPORAL_RAY_SIGMA_PX", F32(RAY_SIGMA_PX)),
+        ("TEMPORAL_CLIP_MOTION_PX", F32(CLIP_MOTION_PX)),
+        ("TEMPORAL_MOVING_RAY_SIGMA_PX", F32(MOVING_RAY_SIGMA_PX)),
+    ])
+}
 
 #[cfg(test)]
 mod tests {

@@ -8,9 +8,9 @@ struct Temporal {
     prev_camera_position_m: vec3<f32>,
     history_valid: u32,         // 0 on the first frame and after a cut
     wind_shift_m: vec2<f32>,    // how far the wind moved the clouds since the previous frame: x, z
-    fresh_weight: f32,          // weight of a pixel's own fresh sample
+    fresh_weight: f32,          // weight of a fresh sample at its own pixel
     clip_gamma: f32,            // half-width of the clip box, in standard deviations
-    unmarched_weight: f32,      // weight toward the upsampled estimate of a pixel without a ray
+    unmarched_weight: f32,      // weight toward the estimate of a pixel far from this frame's rays
     distance_tolerance: f32,    // history dropped where its cloud lies farther off than this fraction
     reserved: vec2<u32>,
 }
@@ -65,17 +65,57 @@ fn temporal_history_bicubic(uv: vec2<f32>) -> vec4<f32> {
     return max(sum, vec4<f32>(0.0));
 }
 
-// Whether the history at uv shows the cloud this pixel sees at `world` (`distance_m` from the
-// camera; the far distance where there is none): the previous camera saw it at the distance the
-// history recorded, within the distance tolerance.
-fn temporal_same_cloud(uv: vec2<f32>, world: vec3<f32>, distance_m: f32) -> bool {
+// A cloud distance as the disocclusion test compares it: the far distance where there is none (0).
+fn temporal_distance_or_far(distance_m: f32) -> f32 {
+    return select(frame.far_m, distance_m, distance_m > 0.0);
+}
+
+// Whether the history at uv shows a cloud this pixel's neighbourhood sees. Either the cloud it
+// recorded can hardly have moved against what lies behind it (the camera's step, seen from that
+// cloud, spans under half a pixel: nothing it hid can have come out), or the distance it recorded
+// lies within the range [lo_m, hi_m] of the distances of this frame's nearby rays, widened by the
+// distance tolerance and by the camera's step. A range, not one interpolated distance: the rays
+// move from sub-pixel to sub-pixel every frame, and at the edges of clouds at different distances
+// the interpolated distance jumps with them; and a cloud thinner than the rays' spacing is missed
+// by all of them in most frames. Either would drop good history and leave the interpolated
+// estimate (a blur, or a cloud seen only at this frame's rays: the grid) in its place.
+fn temporal_same_cloud(uv: vec2<f32>, pixel: vec2<f32>, lo_m: f32, hi_m: f32) -> bool {
     let size = vec2<f32>(textureDimensions(history_distance_in));
     let texel = clamp(vec2<i32>(uv * size), vec2<i32>(0), vec2<i32>(size) - 1);
-    let recorded = textureLoad(history_distance_in, texel, 0).x;
-    let far = frame.far_m;
-    let expected_m = select(far, distance(world, temporal.prev_camera_position_m), distance_m < far);
-    let recorded_m = select(far, recorded, recorded > 0.0);
-    return abs(recorded_m - expected_m) <= temporal.distance_tolerance * max(recorded_m, expected_m);
+    let recorded_m = temporal_distance_or_far(textureLoad(history_distance_in, texel, 0).x);
+    let moved_m = distance(frame.camera_position_m, temporal.prev_camera_position_m);
+    let tolerance = temporal.distance_tolerance;
+    let in_range = recorded_m >= lo_m * (1.0 - tolerance) - moved_m && recorded_m <= hi_m * (1.0 + tolerance) + moved_m;
+    return temporal_parallax_px(pixel, recorded_m) < 0.5 || in_range;
+}
+
+// How far, in pixels, the camera's step since the previous frame moved a cloud `distance_m` away
+// against the far background: the part of the history's motion its reprojection can get wrong
+// (turning the camera moves everything alike, and reprojects exactly).
+fn temporal_parallax_px(pixel: vec2<f32>, distance_m: f32) -> f32 {
+    let moved_m = distance(frame.camera_position_m, temporal.prev_camera_position_m);
+    let pixel_rad = distance(frame_ray_direction(pixel), frame_ray_direction(pixel + vec2<f32>(0.0, 1.0)));
+    return moved_m / (distance_m * pixel_rad);
+}
+
+// Squared distance in pixels from pixel `px` to the nearest ray of this frame's grid (one through
+// pixel c * divisor + grid_subpixel of every block c).
+fn temporal_ray_distance2(px: vec2<u32>) -> f32 {
+    let n = vec2<i32>(i32(frame.grid_divisor));
+    let along = ((vec2<i32>(px) - vec2<i32>(frame.grid_subpixel)) % n + n) % n;
+    let nearest = vec2<f32>(select(along, along - n, 2 * along > n));
+    return dot(nearest, nearest);
+}
+
+// How much of this frame's estimate a pixel takes: the fresh weight at a ray's own pixel, falling
+// off as a Gaussian of TEMPORAL_RAY_SIGMA_PX with the distance to the nearest ray, to the
+// unmarched weight far from every ray. Every pixel meets every offset from the rays once per
+// divisor^2 frames, so all pixels take in new samples at one rate and no grid shows; a ray's
+// sample spreads over the pixels around it as a soft bump, not a dot (Yang et al. 2009,
+// "Amortized supersampling": weights by the distance to the new sample).
+fn temporal_new_weight(px: vec2<u32>, moving: f32) -> f32 {
+    let sigma = mix(TEMPORAL_RAY_SIGMA_PX, TEMPORAL_MOVING_RAY_SIGMA_PX, moving);
+    return temporal.fresh_weight * exp(-temporal_ray_distance2(px) / (2.0 * sigma * sigma));
 }
 
 @compute @workgroup_size(8, 8)
@@ -87,24 +127,27 @@ fn resolve_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     let divisor = frame.grid_divisor;
     let pixel = vec2<f32>(id.xy) + 0.5;
     let host_m = frame_depth_distance(pixel, textureLoad(temporal_host_depth, vec2<i32>(id.xy), 0).x);
+    // The estimate from this frame's rays: a ray's own sample at its pixel, interpolated between.
     let estimate = upsample_cloud(id.xy, host_m);
-    var current = estimate.radiance_transmittance;
-    var cloud_m = estimate.distance_m;
-    // The pixel this frame's ray went through has a sample of its own.
-    let own = vec2<i32>(id.xy / divisor);
-    let fresh = all(id.xy % divisor == frame.grid_subpixel);
-    if fresh {
-        current = textureLoad(coarse_clouds, own, 0);
-        cloud_m = textureLoad(coarse_distance, own, 0).x;
-    }
-    // Neighbourhood statistics of the current grid: the spread sigma of the seed's ClipAABB.
+    let current = estimate.radiance_transmittance;
+    let cloud_m = estimate.distance_m;
+    // The grid texel nearest the pixel, the centre of the neighbourhood.
+    let own = vec2<i32>(floor((pixel - 0.5 - vec2<f32>(frame.grid_subpixel)) / f32(divisor) + 0.5));
+    // Neighbourhood statistics of the current grid: the spread sigma of the seed's ClipAABB, and
+    // the range of cloud distances its rays see.
     var m1 = vec4<f32>(0.0);
     var m2 = vec4<f32>(0.0);
+    var lo_m = frame.far_m;
+    var hi_m = 0.0;
     for (var y = -1; y <= 1; y++) {
         for (var x = -1; x <= 1; x++) {
-            let v = textureLoad(coarse_clouds, upsample_grid_texel(own + vec2<i32>(x, y)), 0);
+            let texel = upsample_grid_texel(own + vec2<i32>(x, y));
+            let v = textureLoad(coarse_clouds, texel, 0);
             m1 += v;
             m2 += v * v;
+            let seen_m = temporal_distance_or_far(textureLoad(coarse_distance, texel, 0).x);
+            lo_m = min(lo_m, seen_m);
+            hi_m = max(hi_m, seen_m);
         }
     }
     let mean = m1 / 9.0;
@@ -122,13 +165,21 @@ fn resolve_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     let uv = vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
     let on_screen = clip.w > 0.0 && all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0));
     var result = current;
-    if temporal.history_valid == 1u && on_screen && temporal_same_cloud(uv, world, distance_m) {
+    if temporal.history_valid == 1u && on_screen && temporal_same_cloud(uv, pixel, lo_m, hi_m) {
         let gamma = temporal.clip_gamma;
-        let history = temporal_clip(temporal_history_bicubic(uv), centre - gamma * sigma, centre + gamma * sigma);
-        // lerp(history, current, w): w is the pixel's own-sample weight when it has one; otherwise
-        // the seed's per-frame blend toward the upsampled estimate, which bleeds out what clipping
-        // let through.
-        result = mix(history, current, select(temporal.unmarched_weight, temporal.fresh_weight, fresh));
+        let reprojected = temporal_history_bicubic(uv);
+        let clipped = temporal_clip(reprojected, centre - gamma * sigma, centre + gamma * sigma);
+        // The history is clipped as far as the camera's step moved it against the background:
+        // where the view holds still or turns it is the better estimate (this frame's sparse rays
+        // miss features thinner than their spacing, and a box from them would erase those features
+        // everywhere but at this frame's rays: the grid); where it shifts by parallax, its
+        // reprojection at an estimated distance may show what is no longer there.
+        let moving = min(temporal_parallax_px(pixel, distance_m) / TEMPORAL_CLIP_MOTION_PX, 1.0);
+        let history = mix(reprojected, clipped, moving);
+        // lerp(history, estimate, w), w by the pixel's distance to this frame's nearest ray: at a
+        // ray's own pixel the estimate is its sample; between rays, where the history moves and is
+        // less to be trusted, the interpolated estimate is taken over a wider bump.
+        result = mix(history, current, temporal_new_weight(id.xy, moving));
     }
     textureStore(history_out, vec2<i32>(id.xy), result);
     textureStore(history_distance_out, vec2<i32>(id.xy), vec4<f32>(cloud_m, 0.0, 0.0, 0.0));

@@ -19,11 +19,14 @@ fn upsample_grid_texel(texel: vec2<i32>) -> vec2<i32> {
 
 // The estimate at full-resolution pixel `px` from the coarse output:
 // bilinear weights over the four nearest grid samples, zeroed where a sample's cloud lies behind
-// this pixel's host geometry (`host_m` away). The cloud's distance averages over the samples that
+// this pixel's host geometry (`host_m` away). Grid texel i was rendered through full-resolution
+// pixel i * divisor + grid_subpixel, so that is where it is weighted from: an estimate that
+// assumed the block's centre would shift by up to 1.5 pixels from frame to frame as the temporal
+// grid's sub-pixel moves, and shimmer. The cloud's distance averages over the samples that
 // see cloud, by how much they see: a clear sample (distance 0) would pull an edge's distance
 // halfway to the camera.
 fn upsample_cloud(px: vec2<u32>, host_m: f32) -> UpsampledCloud {
-    let pos = (vec2<f32>(px) + 0.5) / f32(frame.grid_divisor) - 0.5;
+    let pos = (vec2<f32>(px) - vec2<f32>(frame.grid_subpixel)) / f32(frame.grid_divisor);
     let base = floor(pos);
     let f = pos - base;
     var value = vec4<f32>(0.0);

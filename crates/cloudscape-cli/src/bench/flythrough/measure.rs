@@ -9,10 +9,18 @@ use cloudscape::image::{LdrImage, flip};
 use cloudscape::raymarch::MarchSettings;
 use cloudscape::renderer::{PASS_COUNT, Reuse, SceneRenderer};
 use cloudscape::scene::Scene;
+use cloudscape::shadow::LightingReuse;
 use glam::UVec2;
 use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
+
+/// The lighting a real-time host carries across frames, as the viewer does: the shadow map kept
+/// for half of its finest texel of drift, the light volume warm-started; the converged frames are
+/// lit by the same.
+pub const LIGHTING_REUSE: LightingReuse = LightingReuse {
+    max_shadow_drift_texels: 0.5,
+};
 
 /// The clock the marches are timed by.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -61,8 +69,8 @@ impl ReferenceSteps {
 pub struct Marched {
     /// GPU time of the frame (by the report's clock), milliseconds.
     pub ms: f64,
-    /// Mean LDR FLIP error against the converged frame.
-    pub flip_mean: f32,
+    /// Mean LDR FLIP error against the converged frame (none on frames without references).
+    pub flip_mean: Option<f32>,
     /// [`mean_change`] from the previous frame (none on the first).
     pub change: Option<f64>,
     /// [`flicker`] from the previous frame (none on the first).
@@ -102,12 +110,12 @@ pub struct FrameRecord {
     pub time_s: f32,
     /// The camera's altitude above the ground, metres.
     pub camera_altitude_m: f32,
-    /// The full-resolution march at the scene's step counts.
-    pub full: Marched,
+    /// The full-resolution march at the scene's step counts (frames with references).
+    pub full: Option<Marched>,
     /// The temporal march, run through the sequence in order.
     pub temporal: Marched,
-    /// The converged reference.
-    pub converged: Converged,
+    /// The converged reference (frames with references).
+    pub converged: Option<Converged>,
     /// Empty-space skipping off and on, for frames with the camera above every cloud layer.
     pub hiheight: Option<HiHeight>,
 }
@@ -135,18 +143,21 @@ pub struct Measurer<'a> {
     clock: Clock,
     temporal: Reuse,
     reference: ReferenceSteps,
-    previous: Option<Lumas>,
+    /// The last frame with references and its lumas.
+    previous: Option<(u32, Lumas)>,
 }
 
 impl<'a> Measurer<'a> {
     /// Measures with `renderer` (of a scene whose files resolve against `base_dir`), timing by
-    /// `clock`, marching `temporal` for the temporal march and `reference` for the converged frames.
+    /// `clock`, marching `temporal` for the temporal march and `reference` for the converged
+    /// frames; the marches carry their lighting across frames ([`LIGHTING_REUSE`]).
     pub fn new(
         ctx: &'a GpuContext,
-        (renderer, base_dir): (SceneRenderer, PathBuf),
+        (mut renderer, base_dir): (SceneRenderer, PathBuf),
         clock: Clock,
         (temporal, reference): (Reuse, ReferenceSteps),
     ) -> Measurer<'a> {
+        renderer.clouds().set_lighting_reuse(Some(LIGHTING_REUSE));
         Measurer {
             ctx,
             renderer,
@@ -170,48 +181,64 @@ impl<'a> Measurer<'a> {
         self.renderer.reset_history();
     }
 
-    /// Measures frame `index` of the sequence, the still `still`; `progress` follows the
-    /// converged render, which takes most of the time.
+    /// Measures frame `index` of the sequence, the still `still`: the temporal march, and with
+    /// `references` the full march, the converged frame and (above the layers) empty-space
+    /// skipping too; `progress` follows the converged render, which takes most of the time.
     pub fn measure(
         &mut self,
         index: u32,
         still: &Scene,
+        references: bool,
         progress: impl FnMut(f32),
-    ) -> (FrameRecord, Images) {
+    ) -> (FrameRecord, Option<Images>) {
         let frame = frame_of(still, index);
-        let (full_ms, full) = self.timed(still, &frame, Reuse::None);
         let (temporal_ms, temporal) = self.timed(still, &frame, self.temporal);
-        let (converged_ms, converged) = self.converged(still, progress);
-        let hiheight = self
-            .above_clouds(&frame)
-            .then(|| self.hiheight(still, &frame));
-        let lumas = [&full, &temporal, &converged].map(LdrImage::luma);
-        let steps = self.previous.as_ref().map(|p| changes(p, &lumas));
-        self.previous = Some(lumas);
-        let marched = |ms, image: &LdrImage, k: usize| Marched {
-            ms,
-            flip_mean: flip_mean(&converged, image),
-            change: steps.map(|(change, _)| change[k]),
-            flicker: steps.map(|(_, flicker)| flicker[k]),
-        };
-        let record = FrameRecord {
+        let mut record = FrameRecord {
             index,
             time_s: still.render.time_s,
             camera_altitude_m: self.altitude_m(&frame),
-            full: marched(full_ms, &full, 0),
-            temporal: marched(temporal_ms, &temporal, 1),
-            converged: Converged {
-                wall_ms: converged_ms,
-                change: steps.map(|(change, _)| change[2]),
+            full: None,
+            temporal: Marched {
+                ms: temporal_ms,
+                flip_mean: None,
+                change: None,
+                flicker: None,
             },
-            hiheight,
+            converged: None,
+            hiheight: None,
         };
+        if !references {
+            return (record, None);
+        }
+        let (full_ms, full) = self.timed(still, &frame, Reuse::None);
+        let (converged_ms, converged) = self.converged(still, progress);
+        record.hiheight = self
+            .above_clouds(&frame)
+            .then(|| self.hiheight(still, &frame));
+        let lumas = [&full, &temporal, &converged].map(LdrImage::luma);
+        let steps = match &self.previous {
+            Some((last, previous)) if last + 1 == index => Some(changes(previous, &lumas)),
+            _ => None,
+        };
+        self.previous = Some((index, lumas));
+        let marched = |ms, image: &LdrImage, k: usize| Marched {
+            ms,
+            flip_mean: Some(flip_mean(&converged, image)),
+            change: steps.map(|(change, _)| change[k]),
+            flicker: steps.map(|(_, flicker)| flicker[k]),
+        };
+        record.full = Some(marched(full_ms, &full, 0));
+        record.temporal = marched(temporal_ms, &temporal, 1);
+        record.converged = Some(Converged {
+            wall_ms: converged_ms,
+            change: steps.map(|(change, _)| change[2]),
+        });
         let images = Images {
             full,
             temporal,
             converged,
         };
-        (record, images)
+        (record, Some(images))
     }
 
     /// Makes `still` the renderer's scene. The stills of a fly-through differ from each other in
@@ -235,7 +262,9 @@ impl<'a> Measurer<'a> {
         (ms, self.renderer.images(ctx).ldr)
     }
 
-    /// The converged reference of `still` and the wall time it took, milliseconds.
+    /// The converged reference of `still` and the wall time it took, milliseconds. It is lit
+    /// as the marches are, by the lighting carried across frames, so that it differs from them
+    /// only in the march: what temporal reuse is measured on.
     fn converged(&mut self, still: &Scene, progress: impl FnMut(f32)) -> (f64, LdrImage) {
         let mut reference = still.clone();
         reference.render.primary_steps = Some(self.reference.primary_steps);

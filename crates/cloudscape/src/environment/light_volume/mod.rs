@@ -175,4 +175,27 @@ impl LightVolumeGrid {
             enabled,
         }
     }
+
+    /// Whether this grid, solved for an earlier frame, still serves a frame that would place
+    /// `fresh`: the same cells through the same heights, and every cascade within
+    /// [`RECENTRE_CELLS`] cells of where `fresh` puts it. A real-time host keeps it, and its
+    /// solution stays warm, where recentring on every cell the eye crosses would start the solve
+    /// cold each time.
+    pub fn still_serves(&self, fresh: &LightVolumeGrid) -> bool {
+        let near = |(kept, new): (&LightVolumeCascade, &LightVolumeCascade)| {
+            let offset = (kept.min_m - new.min_m).abs();
+            kept.cell_m == new.cell_m
+                && kept.min_m.y == new.min_m.y
+                && offset.x.max(offset.z) <= RECENTRE_CELLS * new.cell_m.x
+        };
+        self.cells == fresh.cells
+            && self.enabled == fresh.enabled
+            && self.cascades.len() == fresh.cascades.len()
+            && self.cascades.iter().zip(&fresh.cascades).all(near)
+    }
 }
+
+/// How many cells (of its finest cascade, 333 m in the default scene) the eye may move from where
+/// a kept grid was centred before a real-time host recentres it ([`LightVolumeGrid::still_serves`]):
+/// a twelfth of the cascade's half-width, so the eye always has most of the fine cascade around it.
+pub const RECENTRE_CELLS: f32 = 4.0;
