@@ -263,7 +263,14 @@ fn bench_flythrough_spread_compares_both_marches_with_converged_frames() {
     let scratch = Scratch::new("bench-flythrough");
     let scene = flythrough_scene();
     let mut args = vec!["bench", "--flythrough", &scene, "--spread", "--frames", "3"];
-    args.extend(["--warmup", "0", "--reference-spp", "2", "--reference-step-factor", "2"]);
+    args.extend([
+        "--warmup",
+        "0",
+        "--reference-spp",
+        "2",
+        "--reference-step-factor",
+        "2",
+    ]);
     args.extend(["--out", "frames", "--json"]);
     args.extend(TINY);
     let run = cloudscape(scratch.path(), &args, true);
@@ -295,25 +302,55 @@ fn bench_flythrough_spread_compares_both_marches_with_converged_frames() {
 fn bench_flythrough_at_a_frame_rate_marches_every_frame_and_references_runs() {
     let scratch = Scratch::new("bench-flythrough-fps");
     let scene = flythrough_scene();
-    let mut args = vec!["bench", "--flythrough", &scene, "--fps", "30", "--frames", "4"];
+    let mut args = vec![
+        "bench",
+        "--flythrough",
+        &scene,
+        "--fps",
+        "30",
+        "--frames",
+        "4",
+    ];
     args.extend(["--reference-every", "4", "--warmup", "0"]);
-    args.extend(["--reference-spp", "1", "--reference-step-factor", "1", "--json"]);
+    args.extend([
+        "--reference-spp",
+        "1",
+        "--reference-step-factor",
+        "1",
+        "--json",
+    ]);
     args.extend(TINY);
     let run = cloudscape(scratch.path(), &args, true);
     assert!(run.success, "{}", run.stderr);
     let report: serde_json::Value = serde_json::from_str(&run.stdout).expect("JSON on stdout");
     assert_eq!(report["fps"], serde_json::json!(30.0));
     let frames = report["per_frame"].as_array().expect("per-frame records");
-    let times: Vec<f64> = frames.iter().map(|f| f["time_s"].as_f64().unwrap()).collect();
-    assert!((times[3] - 0.1).abs() < 1e-5, "frames 1/30 s apart: {times:?}");
+    let times: Vec<f64> = frames
+        .iter()
+        .map(|f| f["time_s"].as_f64().unwrap())
+        .collect();
+    assert!(
+        (times[3] - 0.1).abs() < 1e-5,
+        "frames 1/30 s apart: {times:?}"
+    );
     // Frame 0 only through the temporal march; the run of three after it with references.
     assert!(frames[0]["full"].is_null() && frames[0]["temporal"]["flip_mean"].is_null());
-    assert!(frames[0]["temporal"]["ms"].as_f64().is_some_and(|ms| ms > 0.0));
+    assert!(
+        frames[0]["temporal"]["ms"]
+            .as_f64()
+            .is_some_and(|ms| ms > 0.0)
+    );
     for frame in &frames[1..] {
         assert!(frame["full"]["flip_mean"].as_f64().is_some(), "{frame}");
     }
-    assert!(frames[1]["temporal"]["flicker"].is_null(), "no pair before the run");
-    assert!(frames[2]["temporal"]["flicker"].as_f64().is_some(), "{report}");
+    assert!(
+        frames[1]["temporal"]["flicker"].is_null(),
+        "no pair before the run"
+    );
+    assert!(
+        frames[2]["temporal"]["flicker"].as_f64().is_some(),
+        "{report}"
+    );
 }
 
 #[test]
