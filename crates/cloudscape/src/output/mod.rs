@@ -19,9 +19,9 @@ pub const CLOUD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const CLOUD_DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// Which rays an output holds: one per pixel of a grid at 1/`divisor` of the frame's resolution,
-/// through sub-pixel `subpixel` of each block, offset along the ray by white noise (stills) or by a
-/// frame's Halton value plus the volumecloud seed's Bayer pattern (temporal reuse). This is the
-/// frame's jitter; [`crate::frame::FrameGpu`] carries it to every technique.
+/// through sub-pixel `subpixel` of each block (the rays' offsets along them follow the frame index:
+/// `frame_blue_noise` in `frame.wgsl`). This is the frame's jitter; [`crate::frame::FrameGpu`]
+/// carries it to every technique.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SampleGrid {
     /// 1, 2 or 4: the grid has 1/divisor of the frame's pixels along each axis.
@@ -31,7 +31,7 @@ pub struct SampleGrid {
 }
 
 impl SampleGrid {
-    /// Every pixel, white-noise offsets: stills.
+    /// Every pixel: stills.
     pub const FULL: SampleGrid = SampleGrid {
         divisor: 1,
         subpixel: UVec2::ZERO,
