@@ -315,25 +315,25 @@ mod tests {
         );
     }
 
+    /// A grey image of `width` x `height` pixels of value `v`.
+    fn grey(v: u8, width: u32, height: u32) -> LdrImage {
+        LdrImage {
+            width,
+            height,
+            pixels: vec![[v, v, v, 255]; (width * height) as usize],
+        }
+    }
+
     #[test]
     fn stack_puts_rows_top_to_bottom() {
-        let row = |v: u8| LdrImage {
-            width: 2,
-            height: 1,
-            pixels: vec![[v, v, v, 255]; 2],
-        };
-        let stacked = stack(&[row(1), row(2)]);
+        let stacked = stack(&[grey(1, 2, 1), grey(2, 2, 1)]);
         assert_eq!((stacked.width, stacked.height), (2, 2));
         assert_eq!(stacked.pixels[2][0], 2);
     }
 
     #[test]
     fn side_by_side_puts_the_images_left_to_right() {
-        let image = |v: u8| LdrImage {
-            width: 2,
-            height: 2,
-            pixels: vec![[v, v, v, 255]; 4],
-        };
+        let image = |v: u8| grey(v, 2, 2);
         let images = Images {
             full: image(1),
             temporal: image(2),
