@@ -21,11 +21,10 @@ pub struct TemporalSettings {
     /// 1, 2 or 4: march one ray per divisor x divisor block per frame (4 updates 1/16 of the pixels,
     /// as Horizon Zero Dawn does).
     pub divisor: u32,
-    /// Weight of new samples per frame at full resolution (the seed's 0.05): pixels far from this
-    /// frame's rays blend toward the interpolated estimate by it, and a ray's own pixel, which gets
-    /// a ray every divisor^2 frames, blends it in with the weight that decays as much over them;
-    /// between the two the weight falls off with the distance to the nearest ray
-    /// ([`RAY_SIGMA_PX`]).
+    /// Weight of new samples per frame at full resolution (the seed's 0.05): a ray's own pixel,
+    /// which gets a ray every divisor^2 frames, blends it in with the weight that decays as much
+    /// over them ([`TemporalSettings::fresh_weight`]), and the pixels around it a part of that
+    /// falling off with their distance to the ray ([`RAY_SIGMA_PX`]).
     pub blend_per_frame: f32,
     /// Half-width of the neighbourhood box the history is clipped to, in standard deviations (the
     /// seed's gamma = 1).
@@ -110,9 +109,9 @@ struct TemporalUniform {
     wind_shift_m: Vec2,
     fresh_weight: f32,
     clip_gamma: f32,
-    unmarched_weight: f32,
     distance_tolerance: f32,
-    reserved: UVec2,
+    reserved_0: u32,
+    reserved_1: UVec2,
 }
 
 /// What the previous frame looked like, for reprojection.
@@ -258,9 +257,9 @@ impl TemporalResolve {
             wind_shift_m: wind_m_per_s * previous.map_or(0.0, |p| frame.time_s - p.time_s),
             fresh_weight: s.fresh_weight(),
             clip_gamma: s.clip_gamma,
-            unmarched_weight: s.blend_per_frame,
             distance_tolerance: s.distance_tolerance,
-            reserved: UVec2::ZERO,
+            reserved_0: 0,
+            reserved_1: UVec2::ZERO,
         };
         ctx.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
@@ -339,9 +338,9 @@ mod tests {
                 wind_shift_m,
                 fresh_weight,
                 clip_gamma,
-                unmarched_weight,
                 distance_tolerance,
-                reserved,
+                reserved_0,
+                reserved_1,
             }
         );
     }

@@ -10,9 +10,9 @@ struct Temporal {
     wind_shift_m: vec2<f32>,    // how far the wind moved the clouds since the previous frame: x, z
     fresh_weight: f32,          // weight of a fresh sample at its own pixel
     clip_gamma: f32,            // half-width of the clip box, in standard deviations
-    unmarched_weight: f32,      // weight toward the estimate of a pixel far from this frame's rays
     distance_tolerance: f32,    // history dropped where its cloud lies farther off than this fraction
-    reserved: vec2<u32>,
+    reserved_0: u32,            // padding to the 16-byte size of a uniform
+    reserved_1: vec2<u32>,
 }
 
 @group(3) @binding(0) var<uniform> temporal: Temporal;
