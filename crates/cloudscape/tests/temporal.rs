@@ -183,3 +183,37 @@ fn a_camera_cut_restarts_the_history() {
         "after a cut no history may leak into the image"
     );
 }
+
+#[test]
+fn lighting_carried_across_frames_keeps_the_image_of_a_still() {
+    use cloudscape::environment::light_volume::CELL_SLICES;
+    use cloudscape::shadow::LightingReuse;
+    let ctx = GpuContext::for_tests();
+    let scene = scene();
+    let before = Frame::from_scene(&scene, SIZE);
+    // A minute later the wind has carried the clouds 500 m.
+    let later = Frame {
+        time_s: before.time_s + 60.0,
+        ..before.clone()
+    };
+    let mut timer = PassTimer::new(&ctx, PASS_COUNT);
+    let mut still = SceneRenderer::new(&ctx, &scene, Path::new(".")).expect("field");
+    still.render_frame(&ctx, &later, Reuse::None, &mut timer);
+    let reference = still.images(&ctx).ldr;
+    // Lit before, then carried over to the later frames: the light volume's cells updated a slice
+    // a frame (every slice comes round), the solve warm-started, the shadow map rebuilt as it drifts.
+    let mut carried = SceneRenderer::new(&ctx, &scene, Path::new(".")).expect("field");
+    carried.clouds().set_lighting_reuse(Some(LightingReuse {
+        max_shadow_drift_texels: 0.5,
+    }));
+    carried.render_frame(&ctx, &before, Reuse::None, &mut timer);
+    for _ in 0..2 * CELL_SLICES {
+        carried.render_frame(&ctx, &later, Reuse::None, &mut timer);
+    }
+    let error = flip_mean(&carried.images(&ctx).ldr, &reference);
+    eprintln!("carried lighting against the still: FLIP {error:.4}");
+    assert!(
+        error < 0.02,
+        "carried lighting drifts from the still's: {error}"
+    );
+}

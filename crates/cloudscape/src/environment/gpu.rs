@@ -119,7 +119,8 @@ pub struct LightVolumeUniform {
     optics: Vec4,
     enabled: u32,
     beam_steps: u32,
-    pad: [u32; 2],
+    cell_slice: u32,
+    pad: u32,
 }
 
 impl LightVolumeUniform {
@@ -142,6 +143,15 @@ impl LightVolumeUniform {
         out.enabled = u32::from(grid.enabled);
         out.beam_steps = beam_steps;
         out
+    }
+
+    /// The same volume, updating the cells' inputs of slice `slice` (of
+    /// [`crate::environment::light_volume::CELL_SLICES`]) on a warm frame.
+    pub fn with_cell_slice(self, slice: u32) -> LightVolumeUniform {
+        LightVolumeUniform {
+            cell_slice: slice,
+            ..self
+        }
     }
 }
 
@@ -582,6 +592,7 @@ mod tests {
                 optics,
                 enabled,
                 beam_steps,
+                cell_slice,
                 pad,
             }
         );

@@ -50,11 +50,24 @@ fn light_volume_centre(c: vec3<u32>, k: u32) -> vec3<f32> {
 // sun's irradiance through the air times exp(-tau') of the coarse field toward the sun.
 @compute @workgroup_size(8, 8)
 fn light_volume_cells(@builtin(global_invocation_id) id: vec3<u32>) {
-    if !light_volume_in_cells(id.xy) {
+    light_volume_cell_inputs(id.xy);
+}
+
+// The cells' inputs of one slice of the rows: every LIGHT_VOLUME_CELL_SLICES-th, from the frame's
+// cell_slice. A warm frame updates one slice and keeps the others' inputs from the last frames
+// (a few frames old: the clouds move 0.13 m a frame at 60 fps in an 8 m/s wind).
+@compute @workgroup_size(8, 8)
+fn light_volume_cells_slice(@builtin(global_invocation_id) id: vec3<u32>) {
+    let row = id.y * LIGHT_VOLUME_CELL_SLICES + environment.light_volume.cell_slice;
+    light_volume_cell_inputs(vec2<u32>(id.x, row));
+}
+
+fn light_volume_cell_inputs(id: vec2<u32>) {
+    if !light_volume_in_cells(id) {
         return;
     }
     let v = environment.light_volume;
-    let ck = light_volume_cell_of(id.xy);
+    let ck = light_volume_cell_of(id);
     let c = ck.xyz;
     let k = ck.w;
     let p = light_volume_centre(c, k);

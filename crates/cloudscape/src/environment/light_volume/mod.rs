@@ -30,7 +30,7 @@ pub mod solve;
 #[cfg(test)]
 mod tests;
 
-pub use pass::{LIGHT_VOLUME_PASS_NAMES, LIGHT_VOLUME_WGSL, LightVolumePass};
+pub use pass::{CELL_SLICES, LIGHT_VOLUME_PASS_NAMES, LIGHT_VOLUME_WGSL, LightVolumePass};
 pub use read::{CASCADE_BLEND_CELLS, LightVolume};
 pub use solve::{Boundaries, DiffuseField, Diffusion};
 

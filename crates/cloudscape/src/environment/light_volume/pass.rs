@@ -17,8 +17,9 @@ pub const LIGHT_VOLUME_PASS_NAMES: [&str; 3] = [
     "light volume table",
 ];
 
-const ENTRIES: [&str; 7] = [
+const ENTRIES: [&str; 8] = [
     "light_volume_cells",
+    "light_volume_cells_slice",
     "light_volume_limit",
     "light_volume_relax_red",
     "light_volume_relax_black",
@@ -26,6 +27,10 @@ const ENTRIES: [&str; 7] = [
     "light_volume_relax_black_uncoupled",
     "light_volume_export",
 ];
+
+/// Slices the cells' rows are updated in on warm frames, one a frame: a warm frame recomputes the
+/// inputs (the coarse field's extinction, the sun's beam through it) of a quarter of the cells.
+pub const CELL_SLICES: u32 = 4;
 
 /// Texels a row of the table's staging buffer is padded to: wgpu copies rows of 256 bytes
 /// (`COPY_BYTES_PER_ROW_ALIGNMENT`), 32 rgba16float texels.
@@ -124,8 +129,8 @@ impl LightVolumePass {
         let mut steps = Vec::new();
         for s in 0..sweeps {
             let coupled = !(cold && s == 0);
-            steps.push((ENTRIES[1], over_cells));
-            let (red, black) = if coupled { (2, 3) } else { (4, 5) };
+            steps.push((ENTRIES[2], over_cells));
+            let (red, black) = if coupled { (3, 4) } else { (5, 6) };
             steps.push((ENTRIES[red], over_columns));
             steps.push((ENTRIES[black], over_columns));
         }
@@ -148,9 +153,16 @@ impl LightVolumePass {
                 compute.dispatch_workgroups(size.x.div_ceil(8), size.y.div_ceil(8), 1);
             }
         };
-        record(cells_name, &[(ENTRIES[0], over_cells)]);
+        let cells = match cold {
+            true => (ENTRIES[0], over_cells),
+            false => (
+                ENTRIES[1],
+                UVec2::new(n.x, over_cells.y.div_ceil(CELL_SLICES)),
+            ),
+        };
+        record(cells_name, &[cells]);
         record(solve_name, &steps);
-        record(table_name, &[(ENTRIES[6], over_cells)]);
+        record(table_name, &[(ENTRIES[7], over_cells)]);
         copy_table(
             encoder,
             &buffers[3],
@@ -216,6 +228,7 @@ fn light_volume_constants() -> String {
         ("LIGHT_VOLUME_BEAM_MIN_SUN_Y", F32(BEAM_MIN_SUN_Y)),
         ("LIGHT_VOLUME_MAX_COLUMN_CELLS", U32(MAX_COLUMN_CELLS)),
         ("LIGHT_VOLUME_ROW_TEXELS", U32(ROW_TEXELS)),
+        ("LIGHT_VOLUME_CELL_SLICES", U32(CELL_SLICES)),
         (
             "LIGHT_VOLUME_MAX_RELATIVE_CURRENT",
             F32(super::solve::MAX_RELATIVE_CURRENT),
