@@ -152,13 +152,10 @@ fn resolve_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let mean = m1 / 9.0;
     let sigma = sqrt(abs(m2 / 9.0 - mean * mean));
-    // The box is centred on this pixel's own estimate, which varies smoothly from pixel to pixel,
-    // rather than on the block's mean, which would print the grid's blocks into the history.
-    let centre = current;
     // Reproject: where the cloud this pixel sees was in the previous frame, at its estimated
     // distance (the far distance where there is none), moved back against the wind.
     let d = frame_ray_direction(pixel);
-    let distance_m = select(frame.far_m, cloud_m, cloud_m > 0.0);
+    let distance_m = temporal_distance_or_far(cloud_m);
     let world = frame.camera_position_m + d * distance_m - vec3<f32>(temporal.wind_shift_m.x, 0.0, temporal.wind_shift_m.y);
     let clip = temporal.prev_clip_from_world * vec4<f32>(world, 1.0);
     let ndc = clip.xy / clip.w;
@@ -168,7 +165,9 @@ fn resolve_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     if temporal.history_valid == 1u && on_screen && temporal_same_cloud(uv, pixel, lo_m, hi_m) {
         let gamma = temporal.clip_gamma;
         let reprojected = temporal_history_bicubic(uv);
-        let clipped = temporal_clip(reprojected, centre - gamma * sigma, centre + gamma * sigma);
+        // The box is centred on this pixel's own estimate, which varies smoothly from pixel to
+        // pixel, rather than on the block's mean, which would print the grid's blocks into it.
+        let clipped = temporal_clip(reprojected, current - gamma * sigma, current + gamma * sigma);
         // The history is clipped as far as the camera's step moved it against the background:
         // where the view holds still or turns it is the better estimate (this frame's sparse rays
         // miss features thinner than their spacing, and a box from them would erase those features
