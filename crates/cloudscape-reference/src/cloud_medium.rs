@@ -293,7 +293,8 @@ pub(crate) fn volume_box(v: &PlacedVolume) -> Aabb {
 }
 
 /// Bound of a voxel grid's extinction over `b`: trilinear filtering never exceeds the largest of
-/// the texels it reads (clamped to the edge, as `VoxelGrid::sample`).
+/// the texels it reads (clamped to the edge, as `BrickGrid::sample`), and no texel exceeds the
+/// largest of its brick.
 fn volume_bound(v: &PlacedVolume, b: &Aabb) -> f32 {
     if !volume_box(v).overlaps(b) {
         return 0.0;
@@ -308,14 +309,7 @@ fn volume_bound(v: &PlacedVolume, b: &Aabb) -> f32 {
             .clamp(IVec3::ZERO, last)
     };
     let (lo, hi) = (texel(b.min), (texel(b.max) + 1).min(last));
-    let mut max = 0.0f32;
-    for z in lo.z..=hi.z {
-        for y in lo.y..=hi.y {
-            for x in lo.x..=hi.x {
-                max = max.max(v.grid.value([x as u32, y as u32, z as u32]));
-            }
-        }
-    }
+    let max = v.grid.max_in_voxels(lo.as_uvec3(), hi.as_uvec3());
     max * v.extinction_per_m * (1.0 + BOUND_RELATIVE_MARGIN)
 }
 

@@ -36,8 +36,8 @@ fn scene(shape: PlanetShape, dir: &std::path::Path) -> Scene {
     });
     scene.volumes.push(VolumeGrid {
         path: "blob.vol".into(),
-        center_m: [800.0, 2600.0, -3000.0],
-        size_m: [1500.0, 1200.0, 1700.0],
+        center_m: Some([800.0, 2600.0, -3000.0]),
+        size_m: Some([1500.0, 1200.0, 1700.0]),
         extinction_per_m: 0.09,
         ..VolumeGrid::default()
     });

@@ -1,13 +1,15 @@
 //! The GPU field agrees with the CPU specification at sample points: layered clouds (noise
-//! generated on the GPU, weather map, type mix, wind) and voxel grids.
+//! generated on the GPU, weather map, type mix, wind) and voxel grids, dense and sparse.
 
 use cloudscape::field::VoxelGrid;
+use cloudscape::field::sparse::{Block, SparseVoxels};
+use cloudscape::field::vdb::{VdbGrid, VdbTransform, write_vdb};
 use cloudscape::frame::Frame;
 use cloudscape::gpu::GpuContext;
 use cloudscape::probe::{Probe, ProbeFunction, ProbeInput};
 use cloudscape::renderer::{CloudRenderer, Reuse};
 use cloudscape::scene::{CloudTypeMix, Scene, VolumeGrid};
-use glam::{UVec2, Vec3, Vec4};
+use glam::{DVec3, IVec3, UVec2, Vec3, Vec4};
 
 /// A deterministic point in the box [min, max].
 fn point(i: u32, min: Vec3, max: Vec3) -> Vec3 {
@@ -123,17 +125,20 @@ fn gpu_voxel_density_equals_cpu_field() {
     };
     let volume = VolumeGrid {
         path: "ball.vol".into(),
-        center_m: [100.0, 2000.0, -300.0],
-        size_m: [1200.0, 800.0, 1000.0],
+        center_m: Some([100.0, 2000.0, -300.0]),
+        size_m: Some([1200.0, 800.0, 1000.0]),
         extinction_per_m: 0.08,
         ..VolumeGrid::default()
     };
-    let min = Vec3::from_array(volume.center_m) - Vec3::from_array(volume.size_m) * 0.55;
-    let max = Vec3::from_array(volume.center_m) + Vec3::from_array(volume.size_m) * 0.55;
+    let (centre, size) = (
+        Vec3::new(100.0, 2000.0, -300.0),
+        Vec3::new(1200.0, 800.0, 1000.0),
+    );
+    let (min, max) = (centre - size * 0.55, centre + size * 0.55);
     scene.volumes = vec![
         volume.clone(),
         VolumeGrid {
-            center_m: [3000.0, 2500.0, 0.0],
+            center_m: Some([3000.0, 2500.0, 0.0]),
             ..volume
         },
     ];
@@ -143,6 +148,89 @@ fn gpu_voxel_density_equals_cpu_field() {
     assert!(a.cloudy > 500, "only {} points inside the grid", a.cloudy);
     assert!(
         a.worst < 1e-4 * 0.08,
+        "GPU and CPU grid extinction differ by {} m^-1",
+        a.worst
+    );
+}
+
+/// A sparse grid's voxels: two puffs far apart in a box off the brick lattice (its first voxel
+/// at -21), one block of them a uniform tile.
+fn two_puffs() -> SparseVoxels {
+    let puffs = [
+        (IVec3::new(-6, 20, 22), 15.0),
+        (IVec3::new(250, 41, 60), 12.0),
+    ];
+    let mut voxels = SparseVoxels {
+        min: IVec3::new(-21, 5, 3),
+        max: IVec3::new(266, 57, 77),
+        ..SparseVoxels::default()
+    };
+    for (centre, radius) in puffs {
+        let reach = IVec3::splat(radius as i32 + 1);
+        let (lo, hi) = (SparseVoxels::block_origin(centre - reach), centre + reach);
+        for bz in (lo.z..=hi.z).step_by(8) {
+            for by in (lo.y..=hi.y).step_by(8) {
+                for bx in (lo.x..=hi.x).step_by(8) {
+                    let origin = IVec3::new(bx, by, bz);
+                    let values = std::array::from_fn(|i| {
+                        let i = i as i32;
+                        let v = origin + IVec3::new(i >> 6, (i >> 3) & 7, i & 7);
+                        (1.0 - (v - centre).as_vec3().length() / radius).max(0.0) * 1.5
+                    });
+                    voxels
+                        .blocks
+                        .insert(origin, Block::Voxels(Box::new(values)));
+                }
+            }
+        }
+    }
+    voxels
+        .blocks
+        .insert(IVec3::new(-8, 16, 16), Block::Uniform(0.75));
+    voxels
+}
+
+#[test]
+fn gpu_sparse_vdb_density_equals_cpu_field() {
+    let dir = std::env::temp_dir().join(format!("cloudscape-gpu-vdb-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let grid = VdbGrid {
+        name: "density".into(),
+        transform: VdbTransform {
+            voxel_size: DVec3::new(10.0, 8.0, 12.0),
+            translation: DVec3::new(500.0, 1500.0, -800.0),
+        },
+        voxels: two_puffs(),
+    };
+    write_vdb(&dir.join("puffs.vdb"), &grid).expect("write .vdb");
+    let scene = Scene {
+        layers: Vec::new(),
+        volumes: vec![VolumeGrid {
+            path: "puffs.vdb".into(),
+            extinction_per_m: 0.06,
+            ..VolumeGrid::default()
+        }],
+        ..Scene::default()
+    };
+    // Points around each puff, where the box holds values.
+    let to_world = |v: IVec3| {
+        v.as_dvec3().as_vec3() * Vec3::new(10.0, 8.0, 12.0) + Vec3::new(500.0, 1500.0, -800.0)
+    };
+    let points: Vec<Vec3> = (0..3000)
+        .map(|i| {
+            let (centre, reach) = if i % 2 == 0 {
+                (IVec3::new(-6, 20, 22), 17)
+            } else {
+                (IVec3::new(250, 41, 60), 14)
+            };
+            point(i, to_world(centre - reach), to_world(centre + reach))
+        })
+        .collect();
+    let a = compare(&scene, &dir, &points, 0.0);
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(a.cloudy > 800, "only {} points inside the puffs", a.cloudy);
+    assert!(
+        a.worst < 1e-4 * 0.06,
         "GPU and CPU grid extinction differ by {} m^-1",
         a.worst
     );

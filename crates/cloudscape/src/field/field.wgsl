@@ -18,9 +18,13 @@ struct FieldVolume {
     min_m: vec3<f32>,             // box minimum corner
     extinction_per_m: f32,        // where the grid value is 1
     size_m: vec3<f32>,            // box size
-    atlas_first_slice: f32,       // first z texel of this grid in the atlas
-    resolution_texels: vec3<f32>, // grid size
-    reserved: f32,
+    table_first: u32,             // where this grid's brick table begins in field_volume_bricks
+    resolution_voxels: vec3<f32>, // voxels along x, y, z of the box
+    reserved_0: f32,
+    first_voxel: vec3<f32>,       // the box's first voxel in the brick lattice (each 0..8)
+    reserved_1: f32,
+    lattice_bricks: vec3<u32>,    // bricks along x, y, z of the lattice
+    reserved_2: u32,
 }
 
 struct Field {
@@ -37,7 +41,7 @@ struct Field {
     layer_count: u32,
     volume_count: u32,
     hiheight_level_count: u32,
-    reserved: vec2<u32>,
+    atlas_bricks_xy: vec2<u32>,   // bricks along x and y of the volume atlas
     layers: array<FieldLayer, MAX_LAYERS>,
     volumes: array<FieldVolume, MAX_VOLUMES>,
     hiheight_levels: array<vec4<u32>, MAX_HIHEIGHT_LEVELS>, // per level: first cell, width, height
@@ -53,6 +57,9 @@ struct Field {
 @group(0) @binding(7) var field_clamp_linear: sampler;
 // Hi-height pyramid cells, all levels back to back: per-layer highest cloud altitude (m).
 @group(0) @binding(8) var<storage, read> field_hiheight: array<vec4<f32>>;
+// The voxel grids' brick tables, back to back: per brick of a lattice, its index in the atlas + 1
+// (0: empty). BrickGrid in field/brick.rs.
+@group(0) @binding(9) var<storage, read> field_volume_bricks: array<u32>;
 
 const FIELD_NO_HIT: f32 = 3.0e38;
 
@@ -188,13 +195,26 @@ fn field_layer_extinction(layer: u32, p: vec3<f32>, h: f32, eroded: bool) -> f32
     return field_erode(covered, detail, f, field.detail_erosion) * w.z * field.layers[layer].extinction_per_m;
 }
 
+// BrickGrid::sample: the brick holding the sample, then trilinear filtering inside its 9^3 texels
+// (its voxels and the first of its neighbours') in the atlas.
 fn field_volume_extinction(v: FieldVolume, p: vec3<f32>) -> f32 {
     let uvw = (p - v.min_m) / v.size_m;
     if any(uvw < vec3<f32>(0.0)) || any(uvw > vec3<f32>(1.0)) {
         return 0.0;
     }
-    let texel = clamp(uvw * v.resolution_texels, vec3<f32>(0.5), v.resolution_texels - 0.5);
-    let atlas_uvw = (vec3<f32>(0.0, 0.0, v.atlas_first_slice) + texel) / vec3<f32>(textureDimensions(field_volume_atlas));
+    let texel = clamp(uvw * v.resolution_voxels - 0.5, vec3<f32>(0.0), v.resolution_voxels - 1.0) + v.first_voxel;
+    let brick = min(vec3<u32>(floor(texel / BRICK_VOXELS)), v.lattice_bricks - 1u);
+    let entry = (brick.z * v.lattice_bricks.y + brick.y) * v.lattice_bricks.x + brick.x;
+    let slot = field_volume_bricks[v.table_first + entry];
+    if slot == 0u {
+        return 0.0;
+    }
+    let row = field.atlas_bricks_xy;
+    let index = slot - 1u;
+    let atlas_brick = vec3<u32>(index % row.x, index / row.x % row.y, index / (row.x * row.y));
+    let local = texel - vec3<f32>(brick) * BRICK_VOXELS;
+    let atlas_texel = vec3<f32>(atlas_brick) * BRICK_TEXELS + local + 0.5;
+    let atlas_uvw = atlas_texel / vec3<f32>(textureDimensions(field_volume_atlas));
     return textureSampleLevel(field_volume_atlas, field_clamp_linear, atlas_uvw, 0.0).x * v.extinction_per_m;
 }
 

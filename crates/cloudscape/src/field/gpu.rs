@@ -2,6 +2,7 @@
 //! atlas uploaded, and the uniform that `field.wgsl` reads, all in one bind group
 //! ([`crate::shader::FIELD_GROUP`]).
 
+use super::brick::{BRICK_TEXELS, BRICK_VOXELS};
 use super::hiheight::HiHeight;
 use super::{CloudField, MAX_LAYERS, MAX_VOLUMES, NoiseKind};
 use crate::gpu::GpuContext;
@@ -33,9 +34,13 @@ struct VolumeUniform {
     min_m: Vec3,
     extinction_per_m: f32,
     size_m: Vec3,
-    atlas_first_slice: f32,
-    resolution_texels: Vec3,
-    reserved: f32,
+    table_first: u32,
+    resolution_voxels: Vec3,
+    reserved_0: f32,
+    first_voxel: Vec3,
+    reserved_1: f32,
+    lattice_bricks: glam::UVec3,
+    reserved_2: u32,
 }
 
 /// The `Field` uniform of `field.wgsl`, member for member.
@@ -55,7 +60,7 @@ struct FieldUniform {
     layer_count: u32,
     volume_count: u32,
     hiheight_level_count: u32,
-    reserved: [u32; 2],
+    atlas_bricks_xy: [u32; 2],
     layers: [LayerUniform; MAX_LAYERS],
     volumes: [VolumeUniform; MAX_VOLUMES],
     hiheight_levels: [[u32; 4]; MAX_HIHEIGHT_LEVELS],
@@ -67,7 +72,7 @@ pub const MAX_HIHEIGHT_LEVELS: usize = 16;
 impl FieldUniform {
     fn new(
         field: &CloudField,
-        atlas: &VolumeAtlas,
+        atlas: &AtlasLayout,
         levels: &[[u32; 3]],
         time_s: f32,
     ) -> FieldUniform {
@@ -87,6 +92,7 @@ impl FieldUniform {
             layer_count: field.layers.len() as u32,
             volume_count: field.volumes.len() as u32,
             hiheight_level_count: levels.len() as u32,
+            atlas_bricks_xy: [atlas.bricks.x, atlas.bricks.y],
             ..FieldUniform::zeroed()
         };
         for (dst, [first, w, h]) in u.hiheight_levels.iter_mut().zip(levels) {
@@ -106,70 +112,118 @@ impl FieldUniform {
                 type_steps: Vec3::from_array(l.types.steps).extend(0.0),
             };
         }
-        for ((dst, v), first_slice) in u
+        for ((dst, v), table_first) in u
             .volumes
             .iter_mut()
             .zip(&field.volumes)
-            .zip(&atlas.first_slices)
+            .zip(&atlas.table_first)
         {
             *dst = VolumeUniform {
                 min_m: v.min_m,
                 extinction_per_m: v.extinction_per_m,
                 size_m: v.size_m,
-                atlas_first_slice: *first_slice as f32,
-                resolution_texels: glam::UVec3::from_array(v.grid.resolution).as_vec3(),
-                reserved: 0.0,
+                table_first: *table_first,
+                resolution_voxels: glam::UVec3::from_array(v.grid.resolution).as_vec3(),
+                first_voxel: v.grid.first_voxel().as_vec3(),
+                lattice_bricks: v.grid.lattice(),
+                ..VolumeUniform::zeroed()
             };
         }
         u
     }
 }
 
-/// All voxel grids stacked along z in one R16Float 3D texture (one binding however many grids);
-/// each grid is sampled clamped to its own texels, so no padding is needed.
+/// Every voxel grid's stored bricks in one R16Float 3D texture, 9^3 texels each (one binding
+/// however many grids), and their tables back to back in one storage buffer, each entry the
+/// brick's index in the atlas + 1 (0: empty): the layout of [`BrickGrid`].
 struct VolumeAtlas {
-    size: glam::UVec3,
-    first_slices: Vec<u32>,
+    layout: AtlasLayout,
     texels: Vec<half::f16>,
+    tables: Vec<u32>,
+}
+
+/// Where the atlas keeps each grid: what the field's uniform says of it.
+struct AtlasLayout {
+    /// Bricks along x, y, z of the texture.
+    bricks: glam::UVec3,
+    /// Where each grid's table begins in the tables.
+    table_first: Vec<u32>,
+}
+
+/// The atlas on the GPU.
+struct UploadedAtlas {
+    layout: AtlasLayout,
+    texture: wgpu::Texture,
+    tables: wgpu::Buffer,
 }
 
 impl VolumeAtlas {
-    fn new(field: &CloudField) -> VolumeAtlas {
-        let res: Vec<[u32; 3]> = field.volumes.iter().map(|v| v.grid.resolution).collect();
-        let w = res.iter().map(|r| r[0]).max().unwrap_or(1);
-        let h = res.iter().map(|r| r[1]).max().unwrap_or(1);
-        let d = res.iter().map(|r| r[2]).sum::<u32>().max(1);
-        let mut texels = vec![half::f16::ZERO; (w * h * d) as usize];
-        let mut first_slices = Vec::new();
-        let mut z0 = 0;
+    /// The atlas of `field`'s grids in a texture at most `max_texels` a side.
+    fn new(field: &CloudField, max_texels: u32) -> VolumeAtlas {
+        let total: usize = field.volumes.iter().map(|v| v.grid.stored_bricks()).sum();
+        let per_row = ((total as f64).cbrt().ceil() as u32).clamp(1, max_texels / BRICK_TEXELS);
+        let rows = (total as u32).div_ceil(per_row * per_row).max(1);
+        let bricks = glam::UVec3::new(per_row, per_row, rows);
+        let size = bricks * BRICK_TEXELS;
+        let mut texels = vec![half::f16::ZERO; (size.x * size.y * size.z) as usize];
+        let (mut tables, mut table_first) = (Vec::new(), Vec::new());
+        let mut base = 0u32;
         for v in &field.volumes {
-            let [gx, gy, gz] = v.grid.resolution;
-            for (i, value) in v.grid.values.iter().enumerate() {
-                let (x, y, z) = (i as u32 % gx, (i as u32 / gx) % gy, i as u32 / (gx * gy));
-                texels[((z0 + z) * h * w + y * w + x) as usize] = half::f16::from_f32(*value);
+            table_first.push(tables.len() as u32);
+            tables.extend(
+                v.grid
+                    .table()
+                    .iter()
+                    .map(|&e| if e == 0 { 0 } else { e + base }),
+            );
+            for slot in 0..v.grid.stored_bricks() {
+                let at = atlas_brick(base + slot as u32, bricks) * BRICK_TEXELS;
+                for (row, line) in v
+                    .grid
+                    .brick_texels(slot)
+                    .chunks_exact(BRICK_TEXELS as usize)
+                    .enumerate()
+                {
+                    let (y, z) = (row as u32 % BRICK_TEXELS, row as u32 / BRICK_TEXELS);
+                    let start = (((at.z + z) * size.y + at.y + y) * size.x + at.x) as usize;
+                    texels[start..start + line.len()].copy_from_slice(line);
+                }
             }
-            first_slices.push(z0);
-            z0 += gz;
+            base += v.grid.stored_bricks() as u32;
         }
+        // A binding needs at least one entry.
+        tables.push(0);
         VolumeAtlas {
-            size: glam::UVec3::new(w, h, d),
-            first_slices,
+            layout: AtlasLayout {
+                bricks,
+                table_first,
+            },
             texels,
+            tables,
         }
     }
+}
+
+/// Where stored brick `index` lies in an atlas of `bricks` bricks: `field_volume_extinction`'s
+/// layout, x fastest.
+fn atlas_brick(index: u32, bricks: glam::UVec3) -> glam::UVec3 {
+    glam::UVec3::new(
+        index % bricks.x,
+        index / bricks.x % bricks.y,
+        index / (bricks.x * bricks.y),
+    )
 }
 
 /// The field's GPU resources and bind group.
 pub struct FieldGpu {
     uniform: wgpu::Buffer,
-    atlas: VolumeAtlas,
+    atlas: UploadedAtlas,
     hiheight_levels: Vec<[u32; 3]>,
     layout: wgpu::BindGroupLayout,
     bind_group: wgpu::BindGroup,
     noise_seed: u32,
     noise: [wgpu::Texture; 3],
     weather: wgpu::Texture,
-    atlas_texture: wgpu::Texture,
     hiheight: wgpu::Buffer,
     samplers: [wgpu::Sampler; 2],
 }
@@ -188,7 +242,7 @@ impl FieldGpu {
         let seed = field.noise_seed();
         let noise = [NoiseKind::Base, NoiseKind::Detail, NoiseKind::Curl]
             .map(|kind| generate_noise(ctx, kind, seed));
-        let atlas = VolumeAtlas::new(field);
+        let atlas = upload_atlas(ctx, field);
         let (cells, hiheight_levels) = HiHeight::new(field).packed();
         let uniform = ctx
             .device
@@ -196,7 +250,7 @@ impl FieldGpu {
                 label: Some("field uniform"),
                 contents: bytemuck::bytes_of(&FieldUniform::new(
                     field,
-                    &atlas,
+                    &atlas.layout,
                     &hiheight_levels,
                     0.0,
                 )),
@@ -218,13 +272,12 @@ impl FieldGpu {
             sampler(wgpu::AddressMode::ClampToEdge),
         ];
         let weather = upload_rgba8(ctx, "weather map", &field.weather.texture);
-        let atlas_texture = upload_atlas(ctx, &atlas);
         let hiheight = hiheight_buffer(ctx, &cells);
-        let textures = [&noise[0], &noise[1], &noise[2], &weather, &atlas_texture];
-        let bind_group = field_bind_group(ctx, &layout, (&uniform, &hiheight), textures, &samplers);
+        let textures = [&noise[0], &noise[1], &noise[2], &weather, &atlas.texture];
+        let buffers = [&uniform, &hiheight, &atlas.tables];
+        let bind_group = field_bind_group(ctx, &layout, buffers, textures, &samplers);
         FieldGpu {
             weather,
-            atlas_texture,
             hiheight,
             uniform,
             atlas,
@@ -248,14 +301,13 @@ impl FieldGpu {
                 .map(|kind| generate_noise(ctx, kind, self.noise_seed));
         }
         self.weather = upload_rgba8(ctx, "weather map", &field.weather.texture);
-        self.atlas = VolumeAtlas::new(field);
-        self.atlas_texture = upload_atlas(ctx, &self.atlas);
+        self.atlas = upload_atlas(ctx, field);
         let (cells, levels) = HiHeight::new(field).packed();
         self.hiheight = hiheight_buffer(ctx, &cells);
         self.hiheight_levels = levels;
         let [base, detail, curl] = &self.noise;
-        let textures = [base, detail, curl, &self.weather, &self.atlas_texture];
-        let buffers = (&self.uniform, &self.hiheight);
+        let textures = [base, detail, curl, &self.weather, &self.atlas.texture];
+        let buffers = [&self.uniform, &self.hiheight, &self.atlas.tables];
         self.bind_group = field_bind_group(ctx, &self.layout, buffers, textures, &self.samplers);
         self.set_time(ctx, field, 0.0);
         FieldUpdate { noise_regenerated }
@@ -263,17 +315,18 @@ impl FieldGpu {
 
     /// Moves the field to scene time `time_s` (wind) for the next submitted work.
     pub fn set_time(&self, ctx: &GpuContext, field: &CloudField, time_s: f32) {
-        let uniform = FieldUniform::new(field, &self.atlas, &self.hiheight_levels, time_s);
+        let uniform = FieldUniform::new(field, &self.atlas.layout, &self.hiheight_levels, time_s);
         ctx.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
 }
 
-/// Bind group 0: the uniform, the noise, weather and atlas textures, the samplers, the pyramid.
+/// Bind group 0: the uniform, the noise, weather and atlas textures, the samplers, the pyramid,
+/// the grids' brick tables.
 fn field_bind_group(
     ctx: &GpuContext,
     layout: &wgpu::BindGroupLayout,
-    (uniform, hiheight): (&wgpu::Buffer, &wgpu::Buffer),
+    [uniform, hiheight, tables]: [&wgpu::Buffer; 3],
     textures: [&wgpu::Texture; 5],
     samplers: &[wgpu::Sampler; 2],
 ) -> wgpu::BindGroup {
@@ -282,6 +335,7 @@ fn field_bind_group(
     resources.extend(views.iter().map(wgpu::BindingResource::TextureView));
     resources.extend(samplers.iter().map(wgpu::BindingResource::Sampler));
     resources.push(hiheight.as_entire_binding());
+    resources.push(tables.as_entire_binding());
     bind_group(&ctx.device, layout, &resources)
 }
 
@@ -308,6 +362,7 @@ fn field_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         sampler,
         sampler,
         pyramid,
+        storage_binding(true),
     ];
     bind_group_layout(device, "field", &types)
 }
@@ -347,9 +402,12 @@ fn upload_rgba8(ctx: &GpuContext, label: &str, texture: &super::Texture8) -> wgp
     t
 }
 
-fn upload_atlas(ctx: &GpuContext, atlas: &VolumeAtlas) -> wgpu::Texture {
-    let dims = atlas.size;
-    let t = create_texture(
+/// Bricks `field`'s grids into an atlas and uploads it.
+fn upload_atlas(ctx: &GpuContext, field: &CloudField) -> UploadedAtlas {
+    let max_texels = ctx.device.limits().max_texture_dimension_3d;
+    let atlas = VolumeAtlas::new(field, max_texels);
+    let dims = atlas.layout.bricks * BRICK_TEXELS;
+    let texture = create_texture(
         ctx,
         "volume atlas",
         dims,
@@ -358,12 +416,23 @@ fn upload_atlas(ctx: &GpuContext, atlas: &VolumeAtlas) -> wgpu::Texture {
     );
     write_texture(
         ctx,
-        &t,
+        &texture,
         bytemuck::cast_slice(&atlas.texels),
         2 * dims.x,
         dims,
     );
-    t
+    let tables = ctx
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("volume brick tables"),
+            contents: bytemuck::cast_slice(&atlas.tables),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+    UploadedAtlas {
+        layout: atlas.layout,
+        texture,
+        tables,
+    }
 }
 
 fn write_texture(
@@ -496,6 +565,8 @@ fn field_constants() -> String {
         ("MAX_LAYERS", U32(super::MAX_LAYERS as u32)),
         ("GOLDEN_RATIO_CONJUGATE", F32(super::GOLDEN_RATIO_CONJUGATE)),
         ("MAX_VOLUMES", U32(super::MAX_VOLUMES as u32)),
+        ("BRICK_VOXELS", F32(BRICK_VOXELS as f32)),
+        ("BRICK_TEXELS", F32(BRICK_TEXELS as f32)),
         ("MAX_HIHEIGHT_LEVELS", U32(MAX_HIHEIGHT_LEVELS as u32)),
         ("TYPE_GRADIENTS", Vec4Array(&TYPE_GRADIENTS)),
         ("TYPE_BLEND_HALF_WIDTH", F32(TYPE_BLEND_HALF_WIDTH)),
@@ -536,7 +607,7 @@ mod tests {
                 layer_count,
                 volume_count,
                 hiheight_level_count,
-                reserved,
+                atlas_bricks_xy,
                 layers,
                 volumes,
                 hiheight_levels,
@@ -565,9 +636,13 @@ mod tests {
                 min_m,
                 extinction_per_m,
                 size_m,
-                atlas_first_slice,
-                resolution_texels,
-                reserved,
+                table_first,
+                resolution_voxels,
+                reserved_0,
+                first_voxel,
+                reserved_1,
+                lattice_bricks,
+                reserved_2,
             }
         );
         assert_wgsl_layout!(

@@ -5,20 +5,27 @@
 //! Horizon Zero Dawn", SIGGRAPH Advances): weather coverage, a per-type height gradient, a
 //! Perlin-Worley base shape and Worley detail erosion, with curl noise displacing the detail.
 
+pub mod brick;
 pub mod gpu;
 pub mod hiheight;
 mod layer;
 pub mod noise;
+mod placed;
 pub mod profile;
 pub mod read_gpu;
 mod reader;
+pub mod sparse;
 pub(crate) mod texture;
+#[cfg(feature = "vdb")]
+pub mod vdb;
 mod vol_file;
 pub mod voxel;
 pub mod weather;
 
+pub use brick::BrickGrid;
 pub use layer::LayerField;
 pub use noise::NoiseKind;
+pub use placed::PlacedVolume;
 pub use reader::{CoarseFieldReader, CpuCoarseReader};
 pub use texture::Texture8;
 pub use voxel::VoxelGrid;
@@ -46,30 +53,6 @@ pub struct FieldError {
     pub key_path: String,
     /// What went wrong.
     pub message: String,
-}
-
-/// A density grid placed in an axis-aligned world box.
-#[derive(Clone, Debug)]
-pub struct PlacedVolume {
-    /// The grid, its values rounded to f16 as the GPU stores them.
-    pub grid: VoxelGrid,
-    /// Minimum corner of the box, metres.
-    pub min_m: Vec3,
-    /// Size of the box, metres.
-    pub size_m: Vec3,
-    /// Extinction where the grid value is 1, m^-1.
-    pub extinction_per_m: f32,
-}
-
-impl PlacedVolume {
-    /// Extinction at `p`, zero outside the box.
-    pub fn extinction_per_m(&self, p: Vec3) -> f32 {
-        let uvw = (p - self.min_m) / self.size_m;
-        if uvw.cmplt(Vec3::ZERO).any() || uvw.cmpgt(Vec3::ONE).any() {
-            return 0.0;
-        }
-        self.grid.sample(uvw) * self.extinction_per_m
-    }
 }
 
 /// Whether detail noise erodes the density.
@@ -221,7 +204,8 @@ pub struct CloudField {
 }
 
 impl CloudField {
-    /// Builds the field of `scene`; files (weather PNG, `.vol` grids) resolve against `base_dir`.
+    /// Builds the field of `scene`; files (weather PNG, `.vol` and `.vdb` grids) resolve against
+    /// `base_dir`.
     pub fn new(scene: &Scene, base_dir: &Path) -> Result<CloudField, FieldError> {
         let err = |key: &str, message: String| FieldError {
             key_path: key.to_string(),
@@ -254,23 +238,8 @@ impl CloudField {
             .iter()
             .enumerate()
             .map(|(i, v)| {
-                let policy = if v.sanitize {
-                    voxel::ValuePolicy::Replace
-                } else {
-                    voxel::ValuePolicy::Reject
-                };
-                let mut grid = VoxelGrid::read_vol_with(&resolve(&v.path), policy)
-                    .map_err(|e| err(&format!("volumes.{i}.path"), e.to_string()))?;
-                grid.values
-                    .iter_mut()
-                    .for_each(|x| *x = half::f16::from_f32(*x).to_f32());
-                let size_m = Vec3::from_array(v.size_m);
-                Ok(PlacedVolume {
-                    grid,
-                    min_m: Vec3::from_array(v.center_m) - size_m * 0.5,
-                    size_m,
-                    extinction_per_m: v.extinction_per_m,
-                })
+                placed::load(v, &resolve(&v.path))
+                    .map_err(|(key, m)| err(&format!("volumes.{i}.{key}"), m))
             })
             .collect::<Result<Vec<_>, FieldError>>()?;
         let seed = scene.noise.seed;

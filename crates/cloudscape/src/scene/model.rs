@@ -442,12 +442,16 @@ impl Default for NoiseSettings {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, DocumentedFields)]
 #[serde(deny_unknown_fields, default)]
 pub struct VolumeGrid {
-    /// Mitsuba 3 `.vol` file, relative to the scene file.
+    /// A Mitsuba 3 `.vol` file or an OpenVDB `.vdb` file, relative to the scene file.
     pub path: String,
-    /// Centre of the box, metres.
-    pub center_m: [f32; 3],
-    /// Size of the box along x, y, z, metres, each > 0.
-    pub size_m: [f32; 3],
+    /// The grid of a `.vdb` file to draw, by name; unset: its first float grid.
+    pub grid: Option<String>,
+    /// Centre of the box, metres; unset: where a `.vdb` grid's transform puts its active voxels,
+    /// [0, 2500, -6000] for a `.vol` file.
+    pub center_m: Option<[f32; 3]>,
+    /// Size of the box along x, y, z, metres, each > 0; unset: a `.vdb` grid's active voxels
+    /// times its voxel size, 2000 m a side for a `.vol` file.
+    pub size_m: Option<[f32; 3]>,
     /// Extinction in m^-1 where the grid value is 1, 0..10.
     pub extinction_per_m: f32,
     /// Replace the file's values that are not densities (NaN and negative by 0, above 65504 by
@@ -459,8 +463,9 @@ impl Default for VolumeGrid {
     fn default() -> Self {
         VolumeGrid {
             path: String::new(),
-            center_m: [0.0, 2500.0, -6000.0],
-            size_m: [2000.0, 2000.0, 2000.0],
+            grid: None,
+            center_m: None,
+            size_m: None,
             extinction_per_m: 0.05,
             sanitize: false,
         }

@@ -263,7 +263,7 @@ fn no_cloud_type(layer: &CloudLayer) -> Option<String> {
 
 fn volume_without_path(volume: &VolumeGrid) -> Option<String> {
     volume.path.trim().is_empty().then(|| {
-        "a volume needs `path`, a Mitsuba 3 .vol file relative to the scene file".to_string()
+        "a volume needs `path`, a Mitsuba 3 .vol or OpenVDB .vdb file relative to the scene file".to_string()
     })
 }
 
