@@ -13,6 +13,7 @@ mod faults;
 mod needs;
 mod reference;
 mod support;
+mod vdb;
 #[cfg(unix)]
 mod view;
 #[cfg(unix)]

@@ -88,11 +88,7 @@ pub(super) fn load(
 
 /// A `.vdb` file's grid and the world box its transform gives its active voxels.
 #[cfg(feature = "vdb")]
-fn read_vdb(
-    volume: &VolumeGrid,
-    path: &Path,
-    policy: voxel::ValuePolicy,
-) -> Loaded {
+fn read_vdb(volume: &VolumeGrid, path: &Path, policy: voxel::ValuePolicy) -> Loaded {
     let vdb = super::vdb::read_vdb(path, volume.grid.as_deref(), policy).map_err(|e| {
         let key = if matches!(e, super::vdb::VdbError::NoGrid { .. }) && volume.grid.is_some() {
             "grid"
@@ -112,11 +108,7 @@ fn read_vdb(
 
 /// Without the `vdb` feature, a `.vdb` file is refused.
 #[cfg(not(feature = "vdb"))]
-fn read_vdb(
-    _: &VolumeGrid,
-    path: &Path,
-    _: voxel::ValuePolicy,
-) -> Loaded {
+fn read_vdb(_: &VolumeGrid, path: &Path, _: voxel::ValuePolicy) -> Loaded {
     Err((
         "path",
         format!(

@@ -64,8 +64,11 @@ def describe(grid, regions, count=2000):
     }
 
 
-def save(directory, name, grids, description):
-    vdb.write(os.path.join(directory, name + ".vdb"), grids=grids)
+def save(directory, name, grids, grid_name, regions=None, count=2000):
+    """Writes the grids as NAME.vdb and describes grid `grid_name` as OpenVDB reads it back."""
+    path = os.path.join(directory, name + ".vdb")
+    vdb.write(path, grids=grids)
+    description = describe(vdb.read(path, grid_name), regions, count) if regions else {"grid": grid_name}
     with open(os.path.join(directory, name + ".json"), "w") as f:
         json.dump(description, f)
 
@@ -78,12 +81,12 @@ def write(directory):
     grid = float_grid("density", xf)
     array = puff(24, 0.8)
     grid.copyFromArray(array, ijk=(-5, 3, 11), tolerance=0.0)
-    save(directory, "puff", [grid], describe(grid, [((-5, 3, 11), array)]))
+    save(directory, "puff", [grid], "density", [((-5, 3, 11), array)])
 
     # The same in half floats.
     half = grid.deepCopy()
     half.saveFloatAsHalf = True
-    save(directory, "puff_half", [half], describe(half, [((-5, 3, 11), array)]))
+    save(directory, "puff_half", [half], "density", [((-5, 3, 11), array)])
 
     # Three grids: a vector grid first, then two float grids; "density" is the second float.
     velocity = vdb.Vec3SGrid()
@@ -94,7 +97,7 @@ def write(directory):
     density = float_grid("density", vdb.createLinearTransform(voxelSize=4.0))
     array = puff(16, 2.0)
     density.copyFromArray(array, ijk=(8, 0, -8), tolerance=0.0)
-    save(directory, "three_grids", [velocity, temperature, density], describe(density, [((8, 0, -8), array)]))
+    save(directory, "three_grids", [velocity, temperature, density], "density", [((8, 0, -8), array)])
 
     # Active tiles: a filled 128^3 node (an internal tile) and a filled 8^3 leaf-sized tile, then
     # pruned, beside voxels; per-axis voxel sizes from a scaling matrix.
@@ -106,22 +109,21 @@ def write(directory):
     scaled.copyFromArray(array, ijk=(140, 3, 5), tolerance=0.0)
     scaled.prune()
     tiles = np.full((128, 128, 128), 0.25, np.float32)
-    save(directory, "tiles", [scaled], describe(scaled, [((0, 0, 0), tiles), ((140, 3, 5), array)]))
+    save(directory, "tiles", [scaled], "density", [((0, 0, 0), tiles), ((140, 3, 5), array)])
 
     # A level set, a rotated grid and a NaN voxel: each refused.
     sphere = vdb.createLevelSetSphere(radius=10.0, voxelSize=1.0)
     sphere.name = "surface"
-    save(directory, "level_set", [sphere], {"grid": "surface"})
+    save(directory, "level_set", [sphere], "surface")
     c, s = math.cos(0.5), math.sin(0.5)
     rotated = float_grid("density", vdb.createLinearTransform(
         [[c, s, 0, 0], [-s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]))
     rotated.copyFromArray(puff(8), ijk=(0, 0, 0), tolerance=0.0)
-    save(directory, "rotated", [rotated], {"grid": "density"})
+    save(directory, "rotated", [rotated], "density")
     broken = float_grid("density", vdb.createLinearTransform(voxelSize=1.0))
-    array = puff(8)
-    array[4, 4, 4] = np.nan
-    broken.copyFromArray(array, ijk=(0, 0, 0), tolerance=0.0)
-    save(directory, "nan", [broken], {"grid": "density", "voxel": [4, 4, 4]})
+    broken.copyFromArray(puff(8), ijk=(0, 0, 0), tolerance=0.0)
+    broken.getAccessor().setValueOn((4, 4, 4), float("nan"))
+    save(directory, "nan", [broken], "density")
 
 
 def write_sparse(directory, size=1024, puffs=12, puff_voxels=96):
@@ -137,7 +139,7 @@ def write_sparse(directory, size=1024, puffs=12, puff_voxels=96):
         array = puff(puff_voxels, 1.0)
         grid.copyFromArray(array, ijk=ijk, tolerance=0.0)
         regions.append((ijk, array))
-    save(directory, "sparse_%d" % size, [grid], describe(grid, regions, 500))
+    save(directory, "sparse_%d" % size, [grid], "density", regions, 500)
 
 
 def check(path, name):

@@ -66,7 +66,7 @@ impl From<Malformed> for HeaderError {
 }
 
 impl Archive {
-    /// Reads the header and the grid descriptors.
+    /// Reads the header and the grid descriptors (each before its grid).
     pub fn parse(bytes: &[u8]) -> Result<Archive, HeaderError> {
         let mut c = Cursor::at(bytes, 0);
         if bytes.len() < 8 || c.i64("the magic number")? != MAGIC {
@@ -112,7 +112,10 @@ impl Descriptor {
         };
         let instance_parent = c.string("a grid's instance parent")?;
         let grid_offset = c.i64("a grid's offset")?;
-        c.take(16, "a grid's block offsets")?;
+        c.i64("a grid's block offset")?;
+        // The next descriptor follows this grid (`io::File::readGridDescriptors`).
+        let end = c.i64("a grid's end offset")?;
+        c.seek(end, "the grid's end")?;
         Ok(Descriptor {
             name,
             tree_type,
@@ -473,6 +476,10 @@ impl TreeReader<'_, '_> {
 
     /// `count` values, compressed as the grid says (`io::readData`, `HalfReader`).
     fn data(&mut self, count: usize) -> Result<Vec<f32>, GridError> {
+        // `HalfReader` reads nothing at all for no values; full floats keep their chunk's size.
+        if self.half && count == 0 {
+            return Ok(Vec::new());
+        }
         let value_bytes = if self.half { 2 } else { 4 };
         let bytes = count * value_bytes;
         let c = &mut *self.c;
