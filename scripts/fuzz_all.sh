@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/../fuzz"
 seconds="${1:-600}"
 mkdir -p logs
-for target in scene vol weather_png table_file sprite_model metar; do
+for target in scene vol vdb weather_png table_file sprite_model metar; do
     mkdir -p "corpus/$target"
     echo "fuzzing $target for $seconds s"
     cargo +nightly fuzz run "$target" "corpus/$target" \

@@ -9,6 +9,8 @@
 use std::path::Path;
 
 use cloudscape::environment::Environment;
+use cloudscape::field::BrickGrid;
+use cloudscape::field::vdb::read_vdb_bytes;
 use cloudscape::field::voxel::{ValuePolicy, VoxelGrid};
 use cloudscape::field::weather::Weather;
 use cloudscape::particles::ParticleTableSpec;
@@ -25,9 +27,10 @@ pub type Outcome = Result<(), String>;
 pub type Target = fn(&[u8]) -> Outcome;
 
 /// Every target by name, as `fuzz_targets/` and `tests/fuzz-regressions/` name them.
-pub const TARGETS: [(&str, Target); 6] = [
+pub const TARGETS: [(&str, Target); 7] = [
     ("scene", scene),
     ("vol", vol),
+    ("vdb", vdb),
     ("weather_png", weather_png),
     ("table_file", table_file),
     ("sprite_model", sprite_model),
@@ -63,6 +66,16 @@ pub fn vol(data: &[u8]) -> Outcome {
     let grid = VoxelGrid::from_vol_bytes(data, Path::new("fuzz.vol"), ValuePolicy::Reject)
         .map_err(|e| e.to_string())?;
     assert!(grid.values.iter().all(|v| v.is_finite() && *v >= 0.0));
+    Ok(())
+}
+
+/// An OpenVDB file: its first float grid, refusing values that are not densities, bricked as the
+/// field bricks it.
+pub fn vdb(data: &[u8]) -> Outcome {
+    let grid = read_vdb_bytes(data, Path::new("fuzz.vdb"), None, ValuePolicy::Reject)
+        .map_err(|e| e.to_string())?;
+    let bricks = BrickGrid::from_sparse(&grid.voxels).map_err(|e| e.to_string())?;
+    assert!((0.0..=65504.0).contains(&bricks.max_value()));
     Ok(())
 }
 

@@ -68,6 +68,11 @@ fn vol_inputs() {
 }
 
 #[test]
+fn vdb_inputs() {
+    assert_all_pass("vdb");
+}
+
+#[test]
 fn weather_png_inputs() {
     assert_all_pass("weather_png");
 }

@@ -25,8 +25,9 @@ pub const BRICK_TEXELS: u32 = BRICK_VOXELS + 1;
 pub const BRICK_TEXEL_COUNT: usize = (BRICK_TEXELS * BRICK_TEXELS * BRICK_TEXELS) as usize;
 /// Most bricks in a grid's lattice (table entries, 4 bytes each: 64 MiB), a box of 2048^3 voxels.
 pub const MAX_LATTICE_BRICKS: u64 = 1 << 24;
-/// Most stored bricks of one grid (1.4 GiB of half-float texels).
-pub const MAX_STORED_BRICKS: usize = 1 << 20;
+/// Most stored bricks of one grid: 730 MiB of half-float texels, 268 million voxels with values
+/// (a dense 645^3 box).
+pub const MAX_STORED_BRICKS: usize = 1 << 19;
 
 /// Why voxels could not be bricked.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

@@ -4,6 +4,8 @@
     openvdb_files.py write DIR        writes the test files into DIR, each NAME.vdb with NAME.json:
                                       the grid to read, its active box, transform and sampled voxels
                                       ([i, j, k, value], as OpenVDB reads them back)
+    openvdb_files.py write-sparse DIR writes sparse_1024.vdb (and .json): puffs over a 1024^3 box
+    openvdb_files.py write-corpus DIR writes the small files of the fuzz target's corpus
     openvdb_files.py check FILE GRID  reads GRID of FILE and prints, as JSON, its active box, voxel
                                       count, transform and every value at the voxels listed on stdin
                                       (a JSON list of [i, j, k])
@@ -142,6 +144,27 @@ def write_sparse(directory, size=1024, puffs=12, puff_voxels=96):
     save(directory, "sparse_%d" % size, [grid], "density", regions, 500)
 
 
+def write_corpus(directory):
+    """Small files for the fuzz target's corpus (crates/cloudscape/tests/fuzz-regressions/vdb/)."""
+    os.makedirs(directory, exist_ok=True)
+    grid = float_grid("density", vdb.createLinearTransform(voxelSize=10.0))
+    grid.copyFromArray(puff(6), ijk=(-3, 5, 2), tolerance=0.0)
+    vdb.write(os.path.join(directory, "puff_blosc.vdb"), grids=[grid])
+    half = grid.deepCopy()
+    half.saveFloatAsHalf = True
+    vdb.write(os.path.join(directory, "puff_half.vdb"), grids=[half])
+    tiles = float_grid("density", vdb.createLinearTransform(voxelSize=1.0))
+    tiles.fill((0, 0, 0), (127, 127, 127), 0.25, True)
+    tiles.fill((128, 0, 0), (135, 7, 7), 0.5, True)
+    tiles.prune()
+    vel = vdb.Vec3SGrid()
+    vel.name = "vel"
+    vel.fill((0, 0, 0), (3, 3, 3), (1.0, 0.0, 0.0), True)
+    vdb.write(os.path.join(directory, "tiles_and_vectors.vdb"), grids=[vel, tiles])
+    sphere = vdb.createLevelSetSphere(radius=3.0, voxelSize=1.0, halfWidth=2.0)
+    vdb.write(os.path.join(directory, "level_set.vdb"), grids=[sphere])
+
+
 def check(path, name):
     grid = vdb.read(path, name)
     voxels = json.load(sys.stdin)
@@ -158,6 +181,8 @@ if __name__ == "__main__":
         write(sys.argv[2])
     elif command == "write-sparse":
         write_sparse(sys.argv[2])
+    elif command == "write-corpus":
+        write_corpus(sys.argv[2])
     elif command == "check":
         check(sys.argv[2], sys.argv[3])
     else:
