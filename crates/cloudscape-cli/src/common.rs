@@ -55,10 +55,20 @@ impl SceneArgs {
     }
 }
 
-/// Prints each of the document's notes (what its overrides replaced) as one line on stderr.
+/// Prints each of the document's notes (what its overrides replaced) as one line on stderr, and
+/// one for voxel grids the scene's technique does not draw.
 pub fn print_notes(document: &SceneDocument) {
     for note in document.notes() {
         eprintln!("note: {note}");
+    }
+    let scene = &document.scene;
+    let technique = scene.render.technique;
+    if !scene.volumes.is_empty() && !cloudscape::renderer::draws(technique).voxel_grids {
+        eprintln!(
+            "note: {} do not draw the scene's [[volumes]] grids; the ray marcher does \
+             (--technique raymarch)",
+            technique.name()
+        );
     }
 }
 

@@ -5,6 +5,7 @@
                                       the grid to read, its active box, transform and sampled voxels
                                       ([i, j, k, value], as OpenVDB reads them back)
     openvdb_files.py write-sparse DIR writes sparse_1024.vdb (and .json): puffs over a 1024^3 box
+    openvdb_files.py write-cumulus DIR writes cumulus.vdb, the README's figure's cloud
     openvdb_files.py write-corpus DIR writes the small files of the fuzz target's corpus
     openvdb_files.py check FILE GRID  reads GRID of FILE and prints, as JSON, its active box, voxel
                                       count, transform and every value at the voxels listed on stdin
@@ -165,6 +166,33 @@ def write_corpus(directory):
     vdb.write(os.path.join(directory, "level_set.vdb"), grids=[sphere])
 
 
+def write_cumulus(directory):
+    """cumulus.vdb: a cumulus of overlapping blobs with eroded edges, 10 m voxels, its base at
+    1500 m, as a cloud artist's tool would hand it over (the README's figure)."""
+    os.makedirs(directory, exist_ok=True)
+    shape = (192, 144, 160)
+    x, y, z = np.meshgrid(*[np.arange(n, dtype=np.float32) for n in shape], indexing="ij")
+    blobs = [((96, 40, 80), 42), ((60, 34, 70), 32), ((132, 36, 88), 34), ((80, 72, 84), 34),
+             ((112, 70, 72), 30), ((96, 100, 80), 26), ((70, 30, 110), 24), ((124, 30, 50), 24)]
+    field = np.zeros(shape, np.float32)
+    for (cx, cy, cz), r in blobs:
+        d = np.sqrt((x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2) / r
+        field = np.maximum(field, 1.0 - d)
+    # Billows: a few octaves of warped sines, eroding only (0 far from the blobs).
+    billows = np.zeros(shape, np.float32)
+    for octave, amplitude in enumerate([0.5, 0.3, 0.2]):
+        f = 0.11 * 2.1 ** octave
+        billows += amplitude * (np.sin(f * x + 1.7 * np.sin(0.7 * f * z + octave))
+                                * np.sin(f * y + 1.3 * np.sin(0.6 * f * x))
+                                * np.sin(f * z + 1.1 * np.sin(0.8 * f * y + 2.0 * octave)))
+    flat_base = np.clip((y - 18.0) / 6.0, 0.0, 1.0)
+    density = np.clip((field - 0.1 * (1.0 + billows)) * 3.0, 0.0, None) * flat_base
+    grid = float_grid("density", vdb.createLinearTransform(voxelSize=10.0))
+    grid.transform.translate((-960.0, 1320.0, -4800.0))
+    grid.copyFromArray(density.astype(np.float32), ijk=(0, 0, 0), tolerance=0.0)
+    vdb.write(os.path.join(directory, "cumulus.vdb"), grids=[grid])
+
+
 def check(path, name):
     grid = vdb.read(path, name)
     voxels = json.load(sys.stdin)
@@ -181,6 +209,8 @@ if __name__ == "__main__":
         write(sys.argv[2])
     elif command == "write-sparse":
         write_sparse(sys.argv[2])
+    elif command == "write-cumulus":
+        write_cumulus(sys.argv[2])
     elif command == "write-corpus":
         write_corpus(sys.argv[2])
     elif command == "check":
