@@ -493,7 +493,10 @@ pub(super) mod tests {
         scene.render.light_steps = Some(6);
         scene.render.samples_per_pixel = Some(4);
         scene.volumes.push(VolumeGrid {
-            path: "cloud.vol".into(),
+            path: "storm.vdb".into(),
+            grid: Some("density".into()),
+            center_m: Some([0.0, 2500.0, -6000.0]),
+            size_m: Some([2000.0; 3]),
             ..VolumeGrid::default()
         });
         scene.sprites.ambient_color = Some([0.3, 0.35, 0.45]);
