@@ -395,6 +395,21 @@ fn export_vdb_round_trips_through_openvdb_and_renders() {
     assert!(cloudscape(scratch.path(), &args, true).success);
     let clear = LdrImage::read_png(&scratch.join("layer.png")).expect("rendered");
     assert_ne!(sky.pixels, clear.pixels, "the exported clouds drew nothing");
+    // A technique that draws no voxel grid says so.
+    let args = [
+        "export",
+        "vdb.toml",
+        "--technique",
+        "particles",
+        "--resolution",
+        "4",
+        "--vdb",
+        "again.vdb",
+    ];
+    let run = cloudscape(scratch.path(), &args, false);
+    assert!(run.success, "{}", run.stderr);
+    let note = "note: particles do not draw the scene's [[volumes]] grids; the ray marcher does";
+    assert!(run.stderr.contains(note), "{}", run.stderr);
 }
 
 /// Bytes of a dense 256^3 grid of half floats (the GPU's 3D texture of such a grid).
