@@ -1,6 +1,9 @@
 //! The GPU field agrees with the CPU specification at sample points: layered clouds (noise
 //! generated on the GPU, weather map, type mix, wind) and voxel grids, dense and sparse.
 
+#[path = "support/puffs.rs"]
+mod puffs;
+
 use cloudscape::field::VoxelGrid;
 use cloudscape::field::sparse::{Block, SparseVoxels};
 use cloudscape::field::vdb::{VdbGrid, VdbTransform, write_vdb};
@@ -156,34 +159,13 @@ fn gpu_voxel_density_equals_cpu_field() {
 /// A sparse grid's voxels: two puffs far apart in a box off the brick lattice (its first voxel
 /// at -21), one block of them a uniform tile.
 fn two_puffs() -> SparseVoxels {
-    let puffs = [
-        (IVec3::new(-6, 20, 22), 15.0),
-        (IVec3::new(250, 41, 60), 12.0),
-    ];
     let mut voxels = SparseVoxels {
         min: IVec3::new(-21, 5, 3),
         max: IVec3::new(266, 57, 77),
         ..SparseVoxels::default()
     };
-    for (centre, radius) in puffs {
-        let reach = IVec3::splat(radius as i32 + 1);
-        let (lo, hi) = (SparseVoxels::block_origin(centre - reach), centre + reach);
-        for bz in (lo.z..=hi.z).step_by(8) {
-            for by in (lo.y..=hi.y).step_by(8) {
-                for bx in (lo.x..=hi.x).step_by(8) {
-                    let origin = IVec3::new(bx, by, bz);
-                    let values = std::array::from_fn(|i| {
-                        let i = i as i32;
-                        let v = origin + IVec3::new(i >> 6, (i >> 3) & 7, i & 7);
-                        (1.0 - (v - centre).as_vec3().length() / radius).max(0.0) * 1.5
-                    });
-                    voxels
-                        .blocks
-                        .insert(origin, Block::Voxels(Box::new(values)));
-                }
-            }
-        }
-    }
+    puffs::add_ball(&mut voxels, IVec3::new(-6, 20, 22), 15.0, 1.5);
+    puffs::add_ball(&mut voxels, IVec3::new(250, 41, 60), 12.0, 1.5);
     voxels
         .blocks
         .insert(IVec3::new(-8, 16, 16), Block::Uniform(0.75));

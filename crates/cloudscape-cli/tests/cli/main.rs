@@ -19,6 +19,10 @@ mod view;
 #[cfg(unix)]
 mod xvfb;
 
+/// Sparse test clouds, shared with the library's GPU field tests.
+#[path = "../../../cloudscape/tests/support/puffs.rs"]
+mod puffs;
+
 /// FLIP against goldens in `tests/golden/`, shared with the library's golden tests.
 #[path = "../../../cloudscape/tests/support/mod.rs"]
 mod golden;

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use cloudscape::field::BrickGrid;
-use cloudscape::field::sparse::{Block, SparseVoxels};
+use cloudscape::field::sparse::{Block, SparseVoxels, block_local};
 use cloudscape::field::vdb::{VdbError, VdbGrid, VdbTransform, read_vdb, write_vdb};
 use cloudscape::field::voxel::ValuePolicy;
 use cloudscape::image::LdrImage;
@@ -17,6 +17,7 @@ use glam::{DVec3, IVec3};
 use serde::Deserialize;
 
 use crate::needs::{self, Missing};
+use crate::puffs::add_ball;
 use crate::support::{Scratch, TINY, cloudscape};
 
 /// What the script says of a grid: as OpenVDB reads it.
@@ -166,9 +167,8 @@ fn files_written_by_openvdb_read_with_the_values_openvdb_reads() {
 fn active_voxel_count(grid: &VdbGrid, from: IVec3) -> u64 {
     let mut count = 0;
     for (origin, block) in &grid.voxels.blocks {
-        for i in 0..512 {
-            let v = *origin + IVec3::new(i >> 6, (i >> 3) & 7, i & 7);
-            let local = (v - *origin).as_uvec3();
+        for local in (0..512).map(block_local) {
+            let v = *origin + local.as_ivec3();
             count += u64::from(v.x >= from.x && block.value(local) != 0.0);
         }
     }
@@ -237,28 +237,8 @@ fn bad_files_are_refused_with_located_errors() {
 /// A cloud of two puffs 200 voxels apart, one block a uniform tile, off the block lattice.
 fn two_puffs() -> VdbGrid {
     let mut voxels = SparseVoxels::default();
-    for (centre, radius) in [
-        (IVec3::new(-6, 20, 22), 10.0f32),
-        (IVec3::new(200, 33, 9), 7.0),
-    ] {
-        let reach = IVec3::splat(radius as i32 + 1);
-        let (lo, hi) = (SparseVoxels::block_origin(centre - reach), centre + reach);
-        for bz in (lo.z..=hi.z).step_by(8) {
-            for by in (lo.y..=hi.y).step_by(8) {
-                for bx in (lo.x..=hi.x).step_by(8) {
-                    let origin = IVec3::new(bx, by, bz);
-                    let values = std::array::from_fn(|i| {
-                        let i = i as i32;
-                        let v = origin + IVec3::new(i >> 6, (i >> 3) & 7, i & 7);
-                        (1.0 - (v - centre).as_vec3().length() / radius).max(0.0) * 0.7
-                    });
-                    voxels
-                        .blocks
-                        .insert(origin, Block::Voxels(Box::new(values)));
-                }
-            }
-        }
-    }
+    add_ball(&mut voxels, IVec3::new(-6, 20, 22), 10.0, 0.7);
+    add_ball(&mut voxels, IVec3::new(200, 33, 9), 7.0, 0.7);
     voxels
         .blocks
         .insert(IVec3::new(96, 0, 0), Block::Uniform(0.25));
@@ -281,7 +261,7 @@ fn voxels_and_values(grid: &VdbGrid) -> (Vec<[i32; 3]>, Vec<f32>) {
         .flat_map(|o| {
             (0..512)
                 .step_by(3)
-                .map(move |i| *o + IVec3::new(i >> 6, (i >> 3) & 7, i & 7))
+                .map(move |i| *o + block_local(i).as_ivec3())
         })
         .map(|v| v.to_array())
         .collect();

@@ -50,6 +50,12 @@ pub fn block_offset(local: UVec3) -> usize {
     ((local.x << 6) | (local.y << 3) | local.z) as usize
 }
 
+/// The voxel at index `offset` of a block's values: the inverse of [`block_offset`].
+pub fn block_local(offset: usize) -> UVec3 {
+    let i = offset as u32;
+    UVec3::new(i >> 6, (i >> 3) & 7, i & 7)
+}
+
 /// Voxels with values in 8^3 blocks, and the box of the ones that count (OpenVDB's active voxels).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SparseVoxels {
@@ -162,6 +168,10 @@ mod tests {
         assert_eq!(block_offset(UVec3::new(0, 0, 1)), 1);
         assert_eq!(block_offset(UVec3::new(0, 1, 0)), 8);
         assert_eq!(block_offset(UVec3::new(1, 0, 0)), 64);
+        assert_eq!(
+            block_local(block_offset(UVec3::new(5, 2, 7))),
+            UVec3::new(5, 2, 7)
+        );
         assert_eq!(
             SparseVoxels::block_origin(IVec3::new(-1, 8, 15)),
             IVec3::new(-8, 8, 8)

@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{DVec3, IVec3, Vec3};
 
-use super::sparse::{Block, SparseVoxels};
+use super::sparse::{Block, SparseVoxels, block_local};
 use super::voxel::ValuePolicy;
 use read::{Archive, GridError, HeaderError};
 
@@ -290,8 +290,7 @@ fn apply_policy(voxels: &mut SparseVoxels, policy: ValuePolicy) -> Option<(IVec3
                 {
                     match policy {
                         ValuePolicy::Reject => {
-                            let i = i as i32;
-                            return Some((origin + IVec3::new(i >> 6, (i >> 3) & 7, i & 7), *v));
+                            return Some((origin + block_local(i).as_ivec3(), *v));
                         }
                         ValuePolicy::Replace => fix(v),
                     }

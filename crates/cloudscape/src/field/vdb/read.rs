@@ -17,7 +17,7 @@ use super::blosc;
 use super::cursor::{Cursor, Malformed, Read};
 use super::{GRID_SEPARATOR, HALF_FLOAT_SUFFIX, MAGIC, VdbTransform};
 use crate::field::brick::MAX_STORED_BRICKS;
-use crate::field::sparse::{BLOCK_VALUES, Block, SparseVoxels};
+use crate::field::sparse::{BLOCK_VALUES, Block, SparseVoxels, block_local};
 
 /// Compression flag: zlib.
 pub(super) const COMPRESS_ZIP: u32 = 0x1;
@@ -598,8 +598,7 @@ impl Voxels {
     /// A leaf's values and its active voxels.
     fn leaf(&mut self, origin: IVec3, mask: &Mask, values: Vec<f32>) -> Result<(), GridError> {
         for i in mask.on() {
-            let i = i as i32;
-            let v = origin + IVec3::new(i >> 6, (i >> 3) & 7, i & 7);
+            let v = origin + block_local(i).as_ivec3();
             self.include(v, v);
         }
         if self.sparse.blocks.len() >= MAX_STORED_BRICKS {
