@@ -299,7 +299,7 @@ fn volume_bound(v: &PlacedVolume, b: &Aabb) -> f32 {
     if !volume_box(v).overlaps(b) {
         return 0.0;
     }
-    let n = UVec3::from_array(v.grid.resolution);
+    let n = UVec3::from_array(v.grid().resolution);
     let last = n.as_ivec3() - 1;
     let texel = |p: Vec3| {
         let uvw = ((p - v.min_m) / v.size_m).clamp(Vec3::ZERO, Vec3::ONE);
@@ -309,7 +309,7 @@ fn volume_bound(v: &PlacedVolume, b: &Aabb) -> f32 {
             .clamp(IVec3::ZERO, last)
     };
     let (lo, hi) = (texel(b.min), (texel(b.max) + 1).min(last));
-    let max = v.grid.max_in_voxels(lo.as_uvec3(), hi.as_uvec3());
+    let max = v.grid().max_in_voxels(lo.as_uvec3(), hi.as_uvec3());
     max * v.extinction_per_m * (1.0 + BOUND_RELATIVE_MARGIN)
 }
 

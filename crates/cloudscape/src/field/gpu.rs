@@ -4,6 +4,7 @@
 
 use super::brick::{BRICK_TEXELS, BRICK_VOXELS};
 use super::hiheight::HiHeight;
+use super::placed::FileGrid;
 use super::{CloudField, MAX_LAYERS, MAX_VOLUMES, NoiseKind};
 use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{
@@ -11,6 +12,7 @@ use crate::gpu::pipeline::{
 };
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
+use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 #[repr(C)]
@@ -123,9 +125,9 @@ impl FieldUniform {
                 extinction_per_m: v.extinction_per_m,
                 size_m: v.size_m,
                 table_first: *table_first,
-                resolution_voxels: glam::UVec3::from_array(v.grid.resolution).as_vec3(),
-                first_voxel: v.grid.first_voxel().as_vec3(),
-                lattice_bricks: v.grid.lattice(),
+                resolution_voxels: glam::UVec3::from_array(v.grid().resolution).as_vec3(),
+                first_voxel: v.grid().first_voxel().as_vec3(),
+                lattice_bricks: v.grid().lattice(),
                 ..VolumeUniform::zeroed()
             };
         }
@@ -155,12 +157,27 @@ struct UploadedAtlas {
     layout: AtlasLayout,
     texture: wgpu::Texture,
     tables: wgpu::Buffer,
+    /// The grids it holds, in the field's order.
+    sources: Vec<Arc<FileGrid>>,
+}
+
+impl UploadedAtlas {
+    /// Whether it holds `field`'s grids, the very ones (a field rebuilt for an edit that left the
+    /// volumes' files alone shares them).
+    fn holds(&self, field: &CloudField) -> bool {
+        self.sources.len() == field.volumes.len()
+            && self
+                .sources
+                .iter()
+                .zip(&field.volumes)
+                .all(|(held, v)| Arc::ptr_eq(held, &v.source))
+    }
 }
 
 impl VolumeAtlas {
     /// The atlas of `field`'s grids in a texture at most `max_texels` a side.
     fn new(field: &CloudField, max_texels: u32) -> VolumeAtlas {
-        let total: usize = field.volumes.iter().map(|v| v.grid.stored_bricks()).sum();
+        let total: usize = field.volumes.iter().map(|v| v.grid().stored_bricks()).sum();
         let per_row = ((total as f64).cbrt().ceil() as u32).clamp(1, max_texels / BRICK_TEXELS);
         let rows = (total as u32).div_ceil(per_row * per_row).max(1);
         let bricks = glam::UVec3::new(per_row, per_row, rows);
@@ -171,15 +188,15 @@ impl VolumeAtlas {
         for v in &field.volumes {
             table_first.push(tables.len() as u32);
             tables.extend(
-                v.grid
+                v.grid()
                     .table()
                     .iter()
                     .map(|&e| if e == 0 { 0 } else { e + base }),
             );
-            for slot in 0..v.grid.stored_bricks() {
+            for slot in 0..v.grid().stored_bricks() {
                 let at = atlas_brick(base + slot as u32, bricks) * BRICK_TEXELS;
                 for (row, line) in v
-                    .grid
+                    .grid()
                     .brick_texels(slot)
                     .chunks_exact(BRICK_TEXELS as usize)
                     .enumerate()
@@ -189,7 +206,7 @@ impl VolumeAtlas {
                     texels[start..start + line.len()].copy_from_slice(line);
                 }
             }
-            base += v.grid.stored_bricks() as u32;
+            base += v.grid().stored_bricks() as u32;
         }
         // A binding needs at least one entry.
         tables.push(0);
@@ -301,7 +318,9 @@ impl FieldGpu {
                 .map(|kind| generate_noise(ctx, kind, self.noise_seed));
         }
         self.weather = upload_rgba8(ctx, "weather map", &field.weather.texture);
-        self.atlas = upload_atlas(ctx, field);
+        if !self.atlas.holds(field) {
+            self.atlas = upload_atlas(ctx, field);
+        }
         let (cells, levels) = HiHeight::new(field).packed();
         self.hiheight = hiheight_buffer(ctx, &cells);
         self.hiheight_levels = levels;
@@ -432,6 +451,7 @@ fn upload_atlas(ctx: &GpuContext, field: &CloudField) -> UploadedAtlas {
         layout: atlas.layout,
         texture,
         tables,
+        sources: field.volumes.iter().map(|v| v.source.clone()).collect(),
     }
 }
 

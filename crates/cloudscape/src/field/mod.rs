@@ -14,6 +14,7 @@ mod placed;
 pub mod profile;
 pub mod read_gpu;
 mod reader;
+mod shared;
 pub mod sparse;
 pub(crate) mod texture;
 #[cfg(feature = "vdb")]
@@ -25,7 +26,7 @@ pub mod weather;
 pub use brick::BrickGrid;
 pub use layer::LayerField;
 pub use noise::NoiseKind;
-pub use placed::PlacedVolume;
+pub use placed::{FileGrid, PlacedVolume};
 pub use reader::{CoarseFieldReader, CpuCoarseReader};
 pub use texture::Texture8;
 pub use voxel::VoxelGrid;
@@ -36,7 +37,7 @@ pub use crate::scene::MAX_LAYERS;
 use crate::scene::{NoiseSettings, PlanetShape, Scene};
 use glam::{Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex, OnceLock, Weak};
+use std::sync::{Arc, OnceLock};
 
 /// `(sqrt(5) - 1) / 2`: successive multiples modulo 1 spread evenly (Weyl's sequence), so the
 /// segments of a light path sample decorrelated offsets.
@@ -159,30 +160,12 @@ impl NoiseSource {
     }
 }
 
-/// The baked noise of `kind` and `seed`, shared by every field that holds it at once: a field
-/// built while another holds the same noise (a live edit, a batch of renders) bakes nothing.
-/// The cache keeps weak references, so the texels go with the last field that holds them.
+/// The baked noise of `kind` and `seed`, shared by every field that holds it at once.
 fn shared_bake(kind: NoiseKind, seed: u32) -> Arc<Texture8> {
-    type Cache = Vec<((NoiseKind, u32), Weak<Texture8>)>;
-    static CACHE: Mutex<Cache> = Mutex::new(Vec::new());
-    let lock = || {
-        CACHE
-            .lock()
-            .unwrap_or_else(|poisoned| poisoned.into_inner())
-    };
-    let held = lock()
-        .iter()
-        .find(|(key, _)| *key == (kind, seed))
-        .and_then(|(_, texels)| texels.upgrade());
-    if let Some(texels) = held {
-        return texels;
-    }
-    // Baked without the lock, so the three kinds bake in parallel.
-    let texels = Arc::new(kind.bake(seed));
-    let mut cache = lock();
-    cache.retain(|(key, held)| held.strong_count() > 0 && *key != (kind, seed));
-    cache.push(((kind, seed), Arc::downgrade(&texels)));
-    texels
+    static CACHE: shared::SharedCache<(NoiseKind, u32), Texture8> = shared::SharedCache::new();
+    let baked: Result<_, std::convert::Infallible> =
+        CACHE.get_or_make((kind, seed), || Ok(kind.bake(seed)));
+    baked.unwrap_or_else(|never| match never {})
 }
 
 /// Every cloud of a scene, as extinction over space and time.

@@ -27,8 +27,8 @@ use half::f16;
 use super::voxel::{VoxelGrid, cell_count};
 use crate::fsutil::write_bytes_atomically;
 
-/// Most cells along one axis of a grid: WebGPU's guaranteed `maxTextureDimension3D`, the size of
-/// the 3D texture the grid is uploaded to.
+/// Most cells along one axis of a grid: WebGPU's guaranteed `maxTextureDimension3D` (the grid is
+/// bricked for the GPU, `field/brick.rs`, whose lattice takes a 2048^3 box).
 pub const MAX_AXIS_CELLS: u32 = 2048;
 /// Most bytes of values (all channels) a `.vol` file may hold: 1 GiB.
 pub const MAX_VALUE_BYTES: usize = 1 << 30;
