@@ -77,8 +77,9 @@ pub struct TechniqueTargets<'a> {
 }
 
 /// One way of rendering the clouds. Made once; [`Technique::prepare`] and [`Technique::encode`]
-/// every frame allocate nothing.
-pub trait Technique {
+/// every frame allocate nothing. Send and Sync, so that a host (a game engine's render thread) can
+/// keep a renderer in shared state.
+pub trait Technique: Send + Sync {
     /// The scene-file name (`render.technique`).
     fn name(&self) -> &'static str;
 

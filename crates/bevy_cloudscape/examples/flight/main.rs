@@ -1,0 +1,143 @@
+//! Fly over a ground with a few towers under cloudscape's clouds.
+//!
+//! `cargo run -p bevy_cloudscape --example flight --ignore-rust-version`
+//!
+//! Keys: W/S forward and back, A/D sideways, Q/E down and up, arrows turn, Shift faster;
+//! C/V less and more cloud; T/G the sun up and down; 1/2/3 ray marcher, particles, sprites;
+//! Space pauses the clouds' clock. The sky is `assets/sky.toml`: edit it while flying.
+
+mod world;
+
+use bevy::prelude::*;
+use bevy_cloudscape::{CloudSky, Clouds, CloudscapePlugin, Technique};
+
+/// The line of help, in the window's title.
+const HELP: &str = "cloudscape | WASD QE fly, arrows turn, Shift fast | C/V cloud -/+ | T/G sun | \
+                    1/2/3 raymarch/particles/sprites | Space pause";
+
+fn main() {
+    App::new()
+        .add_plugins((
+            DefaultPlugins.set(WindowPlugin {
+                primary_window: Some(Window {
+                    title: HELP.into(),
+                    resolution: (1280, 720).into(),
+                    ..default()
+                }),
+                ..default()
+            }),
+            CloudscapePlugin,
+        ))
+        .add_systems(Startup, setup)
+        .add_systems(Update, (fly, change_sky, change_sun, change_clouds))
+        .run();
+}
+
+/// The world of `world.rs` under the sky of `assets/sky.toml`.
+fn setup(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+    assets: Res<AssetServer>,
+) {
+    let sky = assets.load::<CloudSky>("sky.toml");
+    world::spawn_world(&mut commands, &mut meshes, &mut materials, sky);
+}
+
+/// WASD QE moves the camera along its own axes, the arrows turn it.
+fn fly(
+    keys: Res<ButtonInput<KeyCode>>,
+    time: Res<Time<Real>>,
+    mut camera: Single<&mut Transform, With<Camera3d>>,
+) {
+    let dt = time.delta_secs();
+    let speed_m_per_s = if keys.pressed(KeyCode::ShiftLeft) {
+        600.0
+    } else {
+        80.0
+    };
+    let axis = |plus: KeyCode, minus: KeyCode| {
+        f32::from(u8::from(keys.pressed(plus))) - f32::from(u8::from(keys.pressed(minus)))
+    };
+    let (forward, right) = (camera.forward().as_vec3(), camera.right().as_vec3());
+    let motion = forward * axis(KeyCode::KeyW, KeyCode::KeyS)
+        + right * axis(KeyCode::KeyD, KeyCode::KeyA)
+        + Vec3::Y * axis(KeyCode::KeyE, KeyCode::KeyQ);
+    camera.translation += motion * speed_m_per_s * dt;
+    camera.translation.y = camera.translation.y.max(2.0);
+    let turn_rad_per_s = 0.8;
+    camera.rotate_y(axis(KeyCode::ArrowLeft, KeyCode::ArrowRight) * turn_rad_per_s * dt);
+    let pitch = axis(KeyCode::ArrowUp, KeyCode::ArrowDown) * turn_rad_per_s * dt;
+    camera.rotate_local_x(pitch);
+}
+
+/// C/V change the first layer's coverage: an edit of the sky asset, which the clouds pick up.
+fn change_sky(
+    keys: Res<ButtonInput<KeyCode>>,
+    cameras: Query<&Clouds>,
+    mut skies: ResMut<Assets<CloudSky>>,
+) {
+    let step = match (
+        keys.just_pressed(KeyCode::KeyC),
+        keys.just_pressed(KeyCode::KeyV),
+    ) {
+        (true, false) => -0.1,
+        (false, true) => 0.1,
+        _ => return,
+    };
+    for handle in cameras.iter().filter_map(|c| c.sky.as_ref()) {
+        if let Some(mut sky) = skies.get_mut(handle) {
+            for layer in &mut sky.scene_mut().layers {
+                layer.coverage = (layer.coverage + step).clamp(0.0, 1.0);
+            }
+        }
+    }
+}
+
+/// T/G raise and lower the sun; the clouds, the sky and the ground follow it.
+fn change_sun(
+    keys: Res<ButtonInput<KeyCode>>,
+    time: Res<Time<Real>>,
+    mut sun: Single<&mut Transform, With<DirectionalLight>>,
+    mut elevation_deg: Local<Option<f32>>,
+) {
+    let rate = 10.0 * time.delta_secs();
+    let elevation = elevation_deg.get_or_insert(35.0);
+    let before = *elevation;
+    if keys.pressed(KeyCode::KeyT) {
+        *elevation = (*elevation + rate).min(89.0);
+    }
+    if keys.pressed(KeyCode::KeyG) {
+        *elevation = (*elevation - rate).max(-5.0);
+    }
+    if *elevation != before {
+        **sun = world::sun_transform(*elevation, 200.0);
+    }
+}
+
+/// 1/2/3 pick the technique; Space pauses the clouds' clock (Bevy's virtual time).
+fn change_clouds(
+    keys: Res<ButtonInput<KeyCode>>,
+    mut clouds: Query<&mut Clouds>,
+    mut time: ResMut<Time<Virtual>>,
+) {
+    let technique = [
+        (KeyCode::Digit1, Technique::Raymarch),
+        (KeyCode::Digit2, Technique::Particles),
+        (KeyCode::Digit3, Technique::Sprites),
+    ]
+    .into_iter()
+    .find(|(key, _)| keys.just_pressed(*key));
+    if let Some((_, technique)) = technique {
+        for mut c in &mut clouds {
+            c.technique = Some(technique);
+        }
+    }
+    if keys.just_pressed(KeyCode::Space) {
+        if time.is_paused() {
+            time.unpause();
+        } else {
+            time.pause();
+        }
+    }
+}

@@ -1,0 +1,99 @@
+//! The flight example's world: a ground, towers near the camera, a balloon above the clouds, the
+//! sun and a camera with clouds. Shared with the tests, which render it in a window.
+
+use bevy::camera::Exposure;
+use bevy::prelude::*;
+use bevy_cloudscape::{CloudSky, Clouds};
+
+/// Where the camera starts, metres.
+pub const START: Vec3 = Vec3::new(0.0, 40.0, 0.0);
+/// The colour of the near tower, unlit: what the tests look for where it stands.
+pub const TOWER_COLOR: Color = Color::linear_rgb(0.8, 0.05, 0.05);
+/// The near tower: centre on the ground and half-size, metres (straight ahead of the camera).
+pub const TOWER: (Vec3, Vec3) = (Vec3::new(0.0, 0.0, -400.0), Vec3::new(25.0, 120.0, 25.0));
+/// The balloon above the cloud layer, ahead and to the right of the camera, metres: the clouds
+/// hide it.
+pub const BALLOON: Vec3 = Vec3::new(2500.0, 4500.0, -9000.0);
+/// The balloon's radius, metres.
+pub const BALLOON_RADIUS_M: f32 = 400.0;
+
+/// The camera's starting orientation: north, a little above the horizon.
+pub fn start_transform() -> Transform {
+    Transform::from_translation(START).looking_to(Vec3::new(0.0, 0.35, -1.0), Vec3::Y)
+}
+
+/// Spawns the world, the sun and a camera whose clouds are `sky`.
+pub fn spawn_world(
+    commands: &mut Commands,
+    meshes: &mut Assets<Mesh>,
+    materials: &mut Assets<StandardMaterial>,
+    sky: Handle<CloudSky>,
+) {
+    let ground = materials.add(StandardMaterial {
+        base_color: Color::srgb(0.30, 0.34, 0.22),
+        perceptual_roughness: 1.0,
+        ..default()
+    });
+    commands.spawn((
+        Mesh3d(meshes.add(Plane3d::default().mesh().size(60_000.0, 60_000.0))),
+        MeshMaterial3d(ground),
+    ));
+    let concrete = materials.add(StandardMaterial {
+        base_color: Color::srgb(0.55, 0.53, 0.5),
+        perceptual_roughness: 0.9,
+        ..default()
+    });
+    for (x, z, half, height) in [
+        (-260.0, -700.0, 40.0, 180.0),
+        (300.0, -900.0, 60.0, 260.0),
+        (-600.0, -1400.0, 80.0, 140.0),
+    ] {
+        commands.spawn((
+            Mesh3d(meshes.add(Cuboid::new(2.0 * half, height, 2.0 * half))),
+            MeshMaterial3d(concrete.clone()),
+            Transform::from_xyz(x, 0.5 * height, z),
+        ));
+    }
+    let unlit = |color: Color| StandardMaterial {
+        base_color: color,
+        unlit: true,
+        ..default()
+    };
+    let (centre, half) = TOWER;
+    commands.spawn((
+        Mesh3d(meshes.add(Cuboid::new(2.0 * half.x, 2.0 * half.y, 2.0 * half.z))),
+        MeshMaterial3d(materials.add(unlit(TOWER_COLOR))),
+        Transform::from_translation(centre + Vec3::Y * half.y),
+    ));
+    commands.spawn((
+        Mesh3d(meshes.add(Sphere::new(BALLOON_RADIUS_M))),
+        MeshMaterial3d(materials.add(unlit(TOWER_COLOR))),
+        Transform::from_translation(BALLOON),
+    ));
+    commands.spawn((
+        DirectionalLight {
+            illuminance: light_consts::lux::RAW_SUNLIGHT,
+            shadow_maps_enabled: false,
+            ..default()
+        },
+        sun_transform(35.0, 200.0),
+    ));
+    commands.spawn((
+        Camera3d::default(),
+        Exposure::SUNLIGHT,
+        start_transform(),
+        Clouds::from_sky(sky),
+    ));
+}
+
+/// A light shining from the sun at `elevation_deg` above the horizon and `azimuth_deg` clockwise
+/// from north (-z).
+pub fn sun_transform(elevation_deg: f32, azimuth_deg: f32) -> Transform {
+    let (elevation, azimuth) = (elevation_deg.to_radians(), azimuth_deg.to_radians());
+    let toward_sun = Vec3::new(
+        elevation.cos() * azimuth.sin(),
+        elevation.sin(),
+        -elevation.cos() * azimuth.cos(),
+    );
+    Transform::default().looking_to(-toward_sun, Vec3::Y)
+}
