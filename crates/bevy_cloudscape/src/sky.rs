@@ -108,3 +108,25 @@ impl AssetLoader for CloudSkyLoader {
         &["toml"]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_flight_examples_sky_file_loads() {
+        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets");
+        let text = std::fs::read_to_string(dir.join("sky.toml")).expect("assets/sky.toml");
+        let sky = CloudSky::parse(&text, "sky.toml", dir).expect("the example's sky is valid");
+        assert_eq!(sky.scene().layers.len(), 1);
+    }
+
+    #[test]
+    fn an_invalid_scene_file_names_its_line_and_key() {
+        let error = CloudSky::parse("[[layers]]\ncoverage = 2.0\n", "bad.toml", PathBuf::new())
+            .expect_err("coverage 2 is out of range");
+        let message = error.to_string();
+        assert!(message.contains("bad.toml:2"), "{message}");
+        assert!(message.contains("coverage"), "{message}");
+    }
+}

@@ -5,10 +5,14 @@
 //! Keys: W/S forward and back, A/D sideways, Q/E down and up, arrows turn, Shift faster;
 //! C/V less and more cloud; T/G the sun up and down; 1/2/3 ray marcher, particles, sprites;
 //! Space pauses the clouds' clock. The sky is `assets/sky.toml`: edit it while flying.
+//!
+//! `-- --screenshot OUT.png [--size WxH]` saves the window after 60 frames and exits;
+//! `-- --bench N [--size WxH]` times N frames with the clouds and N without, and prints both.
 
 mod world;
 
 use bevy::prelude::*;
+use bevy::render::view::screenshot::Screenshot;
 use bevy_cloudscape::{CloudSky, Clouds, CloudscapePlugin, Technique};
 
 /// The line of help, in the window's title.
@@ -16,21 +20,112 @@ const HELP: &str = "cloudscape | WASD QE fly, arrows turn, Shift fast | C/V clou
                     1/2/3 raymarch/particles/sprites | Space pause";
 
 fn main() {
+    let options = Options::from_args();
     App::new()
         .add_plugins((
             DefaultPlugins.set(WindowPlugin {
                 primary_window: Some(Window {
                     title: HELP.into(),
-                    resolution: (1280, 720).into(),
+                    resolution: options.size.into(),
+                    present_mode: bevy::window::PresentMode::AutoNoVsync,
                     ..default()
                 }),
                 ..default()
             }),
             CloudscapePlugin,
         ))
+        .insert_resource(options)
         .add_systems(Startup, setup)
-        .add_systems(Update, (fly, change_sky, change_sun, change_clouds))
+        .add_systems(
+            Update,
+            (fly, change_sky, change_sun, change_clouds, run_options),
+        )
         .run();
+}
+
+/// What the command line asked for besides flying.
+#[derive(Resource, Default)]
+struct Options {
+    /// Window size, pixels.
+    size: UVec2,
+    /// Save the window here after [`SCREENSHOT_FRAME`] frames, then exit.
+    screenshot: Option<String>,
+    /// Time this many frames with clouds and as many without, then exit.
+    bench: Option<u32>,
+}
+
+/// Frames before `--screenshot` saves the window (and before `--bench` starts timing).
+const SCREENSHOT_FRAME: u32 = 60;
+
+impl Options {
+    fn from_args() -> Options {
+        let mut options = Options {
+            size: UVec2::new(1280, 720),
+            ..default()
+        };
+        let mut args = std::env::args().skip(1);
+        while let Some(arg) = args.next() {
+            let mut value = || args.next().unwrap_or_else(|| panic!("{arg} needs a value"));
+            match arg.as_str() {
+                "--screenshot" => options.screenshot = Some(value()),
+                "--bench" => options.bench = Some(value().parse().expect("--bench N")),
+                "--size" => {
+                    let v = value();
+                    let (w, h) = v.split_once('x').expect("--size WxH");
+                    options.size =
+                        UVec2::new(w.parse().expect("width"), h.parse().expect("height"));
+                }
+                other => panic!("unknown option {other}"),
+            }
+        }
+        options
+    }
+}
+
+/// `--screenshot` and `--bench`: counts frames, saves the window, times the frames.
+fn run_options(
+    mut commands: Commands,
+    options: Res<Options>,
+    time: Res<Time<Real>>,
+    mut clouds: Query<&mut Clouds>,
+    mut exit: MessageWriter<AppExit>,
+    mut frame: Local<u32>,
+    mut timed: Local<Vec<f32>>,
+) {
+    *frame += 1;
+    if let Some(path) = options
+        .screenshot
+        .as_ref()
+        .filter(|_| *frame == SCREENSHOT_FRAME)
+    {
+        commands
+            .spawn(Screenshot::primary_window())
+            .observe(bevy::render::view::screenshot::save_to_disk(path.clone()));
+    }
+    if options.screenshot.is_some() && *frame == SCREENSHOT_FRAME + 5 {
+        exit.write(AppExit::Success);
+    }
+    let Some(n) = options.bench else { return };
+    if *frame > SCREENSHOT_FRAME {
+        timed.push(time.delta_secs() * 1000.0);
+    }
+    if timed.len() == n as usize {
+        for mut c in &mut clouds {
+            c.enabled = false;
+        }
+    }
+    if timed.len() == 2 * n as usize + SCREENSHOT_FRAME as usize / 4 {
+        let mean = |s: &[f32]| s.iter().sum::<f32>() / s.len() as f32;
+        let with = mean(&timed[1..n as usize]);
+        let without = mean(&timed[timed.len() - n as usize + 1..]);
+        println!(
+            "{}x{}: frame with clouds {with:.1} ms, without {without:.1} ms, clouds {:.1} ms",
+            options.size.x,
+            options.size.y,
+            with - without
+        );
+        exit.write(AppExit::Success);
+    }
 }
 
 /// The world of `world.rs` under the sky of `assets/sky.toml`.

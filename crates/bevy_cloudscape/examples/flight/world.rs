@@ -17,6 +17,11 @@ pub const BALLOON: Vec3 = Vec3::new(2500.0, 4500.0, -9000.0);
 /// The balloon's radius, metres.
 pub const BALLOON_RADIUS_M: f32 = 400.0;
 
+/// The camera's exposure: a bright day's, at which raw sunlight (130,000 lux) gives sunlit clouds
+/// about the radiance cloudscape's own renders show at their default exposure (Bevy's
+/// `Exposure::SUNLIGHT`, 15, leaves them grey).
+pub const EV100: f32 = 13.5;
+
 /// The camera's starting orientation: north, a little above the horizon.
 pub fn start_transform() -> Transform {
     Transform::from_translation(START).looking_to(Vec3::new(0.0, 0.35, -1.0), Vec3::Y)
@@ -80,7 +85,7 @@ pub fn spawn_world(
     ));
     commands.spawn((
         Camera3d::default(),
-        Exposure::SUNLIGHT,
+        Exposure { ev100: EV100 },
         start_transform(),
         Clouds::from_sky(sky),
     ));
