@@ -21,6 +21,7 @@ use cloudscape::gpu::GpuContext;
 use cloudscape::post::Background;
 use cloudscape::renderer::{CloudRenderer, Reuse};
 use cloudscape::scene::Scene;
+use cloudscape::shadow::LightingReuse;
 use cloudscape::temporal::TemporalSettings;
 use std::sync::Arc;
 
@@ -129,6 +130,10 @@ fn begin_cloud_frames(
             }),
             None => Reuse::None,
         };
+        let lighting = cloud_view
+            .reuse_lighting
+            .then_some(LightingReuse::REAL_TIME);
+        clouds.renderer.set_lighting_reuse(lighting);
         clouds.renderer.begin_frame(gpu, &frame, reuse);
         clouds.frame_index = clouds.frame_index.wrapping_add(1);
         clouds.begun = true;

@@ -35,6 +35,10 @@ pub struct Clouds {
     /// Temporal reuse: march one ray per `n x n` pixels a frame (2 or 4) and reproject the rest
     /// from the last frames; None marches every pixel every frame.
     pub temporal_grid: Option<u32>,
+    /// Carry the lighting across frames as a game does (`LightingReuse::REAL_TIME`: the clouds'
+    /// shadow map kept until the eye and the wind have moved half of its finest texel, the light
+    /// volume warm-started); false rebuilds both every frame.
+    pub reuse_lighting: bool,
 }
 
 impl Default for Clouds {
@@ -45,6 +49,7 @@ impl Default for Clouds {
             technique: None,
             quality: None,
             temporal_grid: Some(4),
+            reuse_lighting: true,
         }
     }
 }
@@ -68,6 +73,8 @@ pub(crate) struct CloudView {
     pub base_dir: PathBuf,
     /// Temporal reuse's grid (None: every pixel every frame).
     pub temporal_grid: Option<u32>,
+    /// Whether the lighting is carried across frames.
+    pub reuse_lighting: bool,
     /// The sun: the first `DirectionalLight`, in the camera's exposed units.
     pub sun: FrameSun,
     /// Bevy's virtual time, seconds.
@@ -173,6 +180,7 @@ pub(crate) fn update_cloud_views(
             scene,
             base_dir,
             temporal_grid: clouds.temporal_grid,
+            reuse_lighting: clouds.reuse_lighting,
             sun,
             time_s: time.elapsed_secs(),
         });

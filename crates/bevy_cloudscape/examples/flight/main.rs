@@ -7,7 +7,9 @@
 //! Space pauses the clouds' clock. The sky is `assets/sky.toml`: edit it while flying.
 //!
 //! `-- --screenshot OUT.png [--size WxH]` saves the window after 60 frames and exits;
-//! `-- --bench N [--size WxH]` times N frames with the clouds and N without, and prints both.
+//! `-- --bench N [--size WxH] [--cold-lighting]` times N frames with the clouds and N without,
+//! and prints both (`--cold-lighting`: the clouds' lighting rebuilt every frame, as `cloudscape
+//! bench` does).
 
 mod world;
 
@@ -52,6 +54,8 @@ struct Options {
     screenshot: Option<String>,
     /// Time this many frames with clouds and as many without, then exit.
     bench: Option<u32>,
+    /// Rebuild the clouds' lighting every frame.
+    cold_lighting: bool,
 }
 
 /// Frames before `--screenshot` saves the window (and before `--bench` starts timing).
@@ -69,6 +73,7 @@ impl Options {
             match arg.as_str() {
                 "--screenshot" => options.screenshot = Some(value()),
                 "--bench" => options.bench = Some(value().parse().expect("--bench N")),
+                "--cold-lighting" => options.cold_lighting = true,
                 "--size" => {
                     let v = value();
                     let (w, h) = v.split_once('x').expect("--size WxH");
@@ -93,6 +98,11 @@ fn run_options(
     mut timed: Local<Vec<f32>>,
 ) {
     *frame += 1;
+    if *frame == 1 && options.cold_lighting {
+        for mut c in &mut clouds {
+            c.reuse_lighting = false;
+        }
+    }
     if let Some(path) = options
         .screenshot
         .as_ref()

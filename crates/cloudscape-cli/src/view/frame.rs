@@ -17,13 +17,6 @@ use super::panel::{Measured, PanelInputs, PanelOutput, Request};
 use super::present::{PanelPaint, ViewImage};
 use super::viewer::{MAX_FRAME_S, SCRIPTED_FRAME_S, Viewer};
 
-/// How far the eye and the clouds may move before the shadow map is built again: half of its
-/// finest texel (about 120 m under the eye in the default scene), a lag of the clouds' shadows no
-/// one sees, for a pass that costs more than the rest of the frame on a software adapter.
-const LIGHTING_REUSE: LightingReuse = LightingReuse {
-    max_shadow_drift_texels: 0.5,
-};
-
 /// The panels' output of one frame, ready to draw.
 pub(super) struct Ui {
     output: PanelOutput,
@@ -203,7 +196,7 @@ impl Viewer {
         // Without temporal reuse a frame is a still, as `cloudscape render` draws it; with it, the
         // index advances the jitter every frame, and the shadow map is kept while it serves.
         let (frame_index, lighting_reuse) = match self.view.temporal {
-            Some(_) => (self.frame_index as u32, Some(LIGHTING_REUSE)),
+            Some(_) => (self.frame_index as u32, Some(LightingReuse::REAL_TIME)),
             None => (0, None),
         };
         self.clouds.set_lighting_reuse(lighting_reuse);

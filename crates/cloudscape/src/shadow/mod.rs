@@ -177,6 +177,16 @@ pub struct LightingReuse {
     pub max_shadow_drift_texels: f32,
 }
 
+impl LightingReuse {
+    /// What a game at a real-time frame rate carries: the shadow map kept until the eye and the
+    /// clouds have drifted half of its finest texel (about 120 m under the eye in the default
+    /// scene), a lag of the clouds' shadows no one sees, for a pass that costs more than the rest
+    /// of the frame on a software adapter; the light volume warm-started.
+    pub const REAL_TIME: LightingReuse = LightingReuse {
+        max_shadow_drift_texels: 0.5,
+    };
+}
+
 /// What a built map was built for.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BuiltShadow {

@@ -15,13 +15,6 @@ use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// The lighting a real-time host carries across frames, as the viewer does: the shadow map kept
-/// for half of its finest texel of drift, the light volume warm-started; the converged frames are
-/// lit by the same.
-pub const LIGHTING_REUSE: LightingReuse = LightingReuse {
-    max_shadow_drift_texels: 0.5,
-};
-
 /// The clock the marches are timed by.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -150,14 +143,16 @@ pub struct Measurer<'a> {
 impl<'a> Measurer<'a> {
     /// Measures with `renderer` (of a scene whose files resolve against `base_dir`), timing by
     /// `clock`, marching `temporal` for the temporal march and `reference` for the converged
-    /// frames; the marches carry their lighting across frames ([`LIGHTING_REUSE`]).
+    /// frames; the marches carry their lighting across frames ([`LightingReuse::REAL_TIME`], the converged frames lit by the same).
     pub fn new(
         ctx: &'a GpuContext,
         (mut renderer, base_dir): (SceneRenderer, PathBuf),
         clock: Clock,
         (temporal, reference): (Reuse, ReferenceSteps),
     ) -> Measurer<'a> {
-        renderer.clouds().set_lighting_reuse(Some(LIGHTING_REUSE));
+        renderer
+            .clouds()
+            .set_lighting_reuse(Some(LightingReuse::REAL_TIME));
         Measurer {
             ctx,
             renderer,

@@ -9,7 +9,7 @@
 //! compared by FLIP with a converged reference of the same frame, with the frame-to-frame change
 //! and flicker of each sequence within the run ([`flicker`]); where the camera is above the cloud
 //! layers, the full march with empty-space skipping off and on. Both marches carry their lighting
-//! from frame to frame as a real-time host does ([`measure::LIGHTING_REUSE`]), so their times differ
+//! from frame to frame as a real-time host does ([`cloudscape::shadow::LightingReuse::REAL_TIME`]), so their times differ
 //! by what temporal reuse saves. The full march renders each of its frames after the temporal march
 //! has brought the lighting up to date, so it never pays for a rebuild of the shadow map or a cold
 //! solve of the light volume: its time, and the ratio of the two, are conservative.
