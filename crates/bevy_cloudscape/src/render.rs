@@ -149,7 +149,7 @@ fn view_clouds<'a>(
     main: Entity,
     cloud_view: &CloudView,
 ) -> Option<&'a mut ViewClouds> {
-    let (scene, dir) = (&cloud_view.scene, &cloud_view.base_dir);
+    let (scene, dir) = (&cloud_view.sky.scene, &cloud_view.sky.base_dir);
     if let Some(clouds) = views.get_mut(&main) {
         if !Arc::ptr_eq(&clouds.scene, scene) {
             if let Err(e) = clouds.renderer.apply_edit(gpu, scene, dir) {

@@ -64,13 +64,24 @@ impl Clouds {
     }
 }
 
+/// A camera's scene: its sky with its overrides.
+#[derive(Clone)]
+pub(crate) struct SkyScene {
+    /// The scene with the camera's overrides, shared (a new one when the sky or a setting changed).
+    pub scene: Arc<Scene>,
+    /// The sky's own scene it was made from.
+    source: Arc<Scene>,
+    /// The camera's technique and quality it applies.
+    overrides: (Option<Technique>, Option<Quality>),
+    /// Where the scene's relative paths resolve.
+    pub base_dir: PathBuf,
+}
+
 /// One camera's clouds this frame, as the render world receives them.
 #[derive(Component, Clone)]
 pub(crate) struct CloudView {
-    /// The scene with the camera's overrides, shared (a new one when the sky or a setting changed).
-    pub scene: Arc<Scene>,
-    /// Where the scene's relative paths resolve.
-    pub base_dir: PathBuf,
+    /// The scene.
+    pub sky: SkyScene,
     /// Temporal reuse's grid (None: every pixel every frame).
     pub temporal_grid: Option<u32>,
     /// Whether the lighting is carried across frames.
@@ -168,17 +179,16 @@ pub(crate) fn update_cloud_views(
             commands.entity(entity).remove::<CloudView>();
             continue;
         };
-        let (scene, base_dir) = scene_of(sky, clouds, previous);
+        let sky = scene_of(sky, clouds, previous);
         let exposure = exposure.copied().unwrap_or_default().exposure();
-        let radius_rad = scene.sun.angular_radius_deg.to_radians();
+        let radius_rad = sky.scene.sun.angular_radius_deg.to_radians();
         let sun = lights
             .iter()
             .next()
             .map(|(light, transform)| sun_of(light, transform, exposure, radius_rad))
-            .unwrap_or_else(|| FrameSun::from_scene(&scene.sun));
+            .unwrap_or_else(|| FrameSun::from_scene(&sky.scene.sun));
         commands.entity(entity).insert(CloudView {
-            scene,
-            base_dir,
+            sky,
             temporal_grid: clouds.temporal_grid,
             reuse_lighting: clouds.reuse_lighting,
             sun,
@@ -187,26 +197,31 @@ pub(crate) fn update_cloud_views(
     }
 }
 
-/// The sky's scene with the camera's technique and quality; the previous frame's when nothing
-/// changed, so the render world sees an edit as a new scene and nothing else as one.
-fn scene_of(
-    sky: &CloudSky,
-    clouds: &Clouds,
-    previous: Option<&CloudView>,
-) -> (Arc<Scene>, PathBuf) {
-    let (shared, base_dir) = sky.shared();
-    let mut scene = (*shared).clone();
+/// The sky's scene with the camera's technique and quality: the previous frame's unless the sky
+/// (a new `Arc` after any edit or reload) or the camera's overrides changed, so that the render
+/// world sees an edit as a new scene and nothing else as one, and a frame clones no scene.
+fn scene_of(sky: &CloudSky, clouds: &Clouds, previous: Option<&CloudView>) -> SkyScene {
+    let (source, base_dir) = sky.shared();
+    let overrides = (clouds.technique, clouds.quality);
+    if let Some(view) = previous
+        && Arc::ptr_eq(&view.sky.source, &source)
+        && view.sky.overrides == overrides
+        && view.sky.base_dir == base_dir
+    {
+        return view.sky.clone();
+    }
+    let mut scene = (*source).clone();
     if let Some(technique) = clouds.technique {
         scene.render.technique = technique;
     }
     if let Some(quality) = clouds.quality {
         scene.render.quality = quality;
     }
-    match previous {
-        Some(view) if *view.scene == scene && view.base_dir == base_dir => {
-            (view.scene.clone(), base_dir)
-        }
-        _ => (Arc::new(scene), base_dir),
+    SkyScene {
+        scene: Arc::new(scene),
+        source,
+        overrides,
+        base_dir,
     }
 }
 
