@@ -12,20 +12,10 @@ mod golden;
     reason = "the harness's file edits serve the hot-reload test"
 )]
 mod harness;
-#[path = "../../cloudscape-cli/tests/cli/needs.rs"]
-mod needs;
-#[path = "../examples/flight/world.rs"]
-#[allow(
-    dead_code,
-    reason = "the example's world, of which the tests use a part"
-)]
-mod world;
-#[path = "../../cloudscape-cli/tests/cli/xvfb.rs"]
-mod xvfb;
 
 use bevy::math::Vec3;
 use cloudscape::image::LdrImage;
-use harness::{Step, color_around, redness};
+use harness::{Step, color_around, needs, redness, world};
 use std::path::Path;
 use std::sync::OnceLock;
 

@@ -2,18 +2,8 @@
 //! balloon, in a clear sky, disappears once its sky file is rewritten as an overcast deck.
 
 mod harness;
-#[path = "../../cloudscape-cli/tests/cli/needs.rs"]
-mod needs;
-#[path = "../examples/flight/world.rs"]
-#[allow(
-    dead_code,
-    reason = "the example's world, of which the tests use a part"
-)]
-mod world;
-#[path = "../../cloudscape-cli/tests/cli/xvfb.rs"]
-mod xvfb;
 
-use harness::{Step, color_around, redness};
+use harness::{Step, color_around, needs, redness, world};
 use std::path::Path;
 
 /// A sky with a layer but no cloud in it.

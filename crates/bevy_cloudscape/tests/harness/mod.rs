@@ -13,8 +13,22 @@ use cloudscape::image::LdrImage;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-use crate::world;
-use crate::xvfb::Xvfb;
+use xvfb::Xvfb;
+
+/// What a test needs from the machine (the CLI's tests' module: Xvfb's program and libraries).
+#[path = "../../../cloudscape-cli/tests/cli/needs.rs"]
+pub mod needs;
+/// The flight example's world, which the tests render.
+#[path = "../../examples/flight/world.rs"]
+#[allow(
+    dead_code,
+    reason = "the example's world, of which the tests use a part"
+)]
+pub mod world;
+/// A virtual X server (the CLI's tests' module; it reaches `needs` as `crate::needs`, which each
+/// test file's root re-exports).
+#[path = "../../../cloudscape-cli/tests/cli/xvfb.rs"]
+mod xvfb;
 
 /// Window size: small, for a 2-core software GPU.
 pub const SIZE: UVec2 = UVec2::new(256, 144);
