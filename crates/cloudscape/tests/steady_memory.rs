@@ -21,15 +21,10 @@ const SIZE: UVec2 = UVec2::new(48, 27);
 const WARMUP_FRAMES: u32 = 8;
 /// Frames between the two readings.
 const MEASURED_FRAMES: u32 = 48;
-/// Largest growth of resident memory per measured frame, bytes: an eighth of what the leaking pass
-/// lost a frame. Measured here with the fix: 0 and 60 KiB over 48 frames in two runs; without it:
-/// 10 MB.
-const MAX_GROWTH_BYTES_PER_FRAME: u64 = 350 * 1024 / 8;
-/// Frames before and between the readings for the particles on OpenGL: their light occlusion pass
-/// takes about 18 s a frame on llvmpipe's GL (0.5 s on lavapipe's Vulkan; docs/particles.md), so
-/// 56 frames would hold CI for 17 minutes. A leak the size of the one this test guards against
-/// still shows over 8 frames (2.8 MB against a bound of 350 KB).
-const GL_PARTICLE_FRAMES: (u32, u32) = (3, 8);
+/// Largest growth of resident memory over the measured frames, bytes: an eighth of what the
+/// leaking pass lost over as many frames. Measured here with the fix: 0 and 60 KiB in two runs;
+/// without it: 10 MB.
+const MAX_GROWTH_BYTES: u64 = MEASURED_FRAMES as u64 * 350 * 1024 / 8;
 
 #[cfg(target_os = "linux")]
 #[test]
@@ -61,10 +56,6 @@ fn steady_frames(ctx: &GpuContext, technique: Technique) {
         divisor: 4,
         ..TemporalSettings::default()
     });
-    let (warmup, measured) = match (ctx.adapter_info().backend, technique) {
-        (wgpu::Backend::Gl, Technique::Particles) => GL_PARTICLE_FRAMES,
-        _ => (WARMUP_FRAMES, MEASURED_FRAMES),
-    };
     let mut render = |index: u32| {
         let frame = Frame {
             frame_index: index,
@@ -72,18 +63,17 @@ fn steady_frames(ctx: &GpuContext, technique: Technique) {
         };
         renderer.render_frame(ctx, &frame, reuse, &mut timer);
     };
-    (0..warmup).for_each(&mut render);
+    (0..WARMUP_FRAMES).for_each(&mut render);
     let before = resident_bytes();
-    (warmup..warmup + measured).for_each(&mut render);
+    (WARMUP_FRAMES..WARMUP_FRAMES + MEASURED_FRAMES).for_each(&mut render);
     let after = resident_bytes();
     let growth = after.saturating_sub(before);
-    let bound = u64::from(measured) * MAX_GROWTH_BYTES_PER_FRAME;
     let name = technique.name();
-    eprintln!("{name}: resident memory over {measured} frames: {before} -> {after} bytes");
+    eprintln!("{name}: resident memory over {MEASURED_FRAMES} frames: {before} -> {after} bytes");
     assert!(
-        growth <= bound,
-        "{name}: resident memory grew {growth} bytes over {measured} frames \
-         ({before} -> {after}); at most {bound} allowed"
+        growth <= MAX_GROWTH_BYTES,
+        "{name}: resident memory grew {growth} bytes over {MEASURED_FRAMES} frames \
+         ({before} -> {after}); at most {MAX_GROWTH_BYTES} allowed"
     );
 }
 

@@ -66,11 +66,18 @@ pub struct LightOcclusion {
     uniform: wgpu::Buffer,
     tile_counts: wgpu::Buffer,
     tile_entries: wgpu::Buffer,
+    /// How many tiles list a particle, then their indices.
+    listed_tiles: wgpu::Buffer,
     stats: wgpu::Buffer,
     /// The grid's shape the lists were sized for: (tiles per side, levels, capacity).
     shape: (u32, u32, u32),
     group: Option<wgpu::BindGroup>,
 }
+
+/// Workgroups of the sort, each taking every this-many-th tile that lists a particle: enough
+/// invocations (256 each) to fill a large GPU, few enough that starting them costs little where
+/// that is slow (llvmpipe's OpenGL).
+const LIGHT_SORT_WORKGROUPS: u32 = 1024;
 
 /// Bytes of the light-tile counters.
 const STATS_BYTES: u64 = 8;
@@ -93,6 +100,7 @@ impl LightOcclusion {
                 "light tile entries",
                 count * u64::from(tiles.tile_capacity()) * 4,
             ),
+            listed_tiles: storage_buffer(ctx, "listed light tiles", (count + 1) * 4),
             stats: storage_buffer(ctx, "light tile stats", STATS_BYTES),
             shape: Self::shape_of(tiles),
             group: None,
@@ -137,12 +145,14 @@ impl LightOcclusion {
                         ("tile_counts", self.tile_counts.as_entire_binding()),
                         ("tile_entries", self.tile_entries.as_entire_binding()),
                         ("light_stats", self.stats.as_entire_binding()),
+                        ("listed_tiles", self.listed_tiles.as_entire_binding()),
                     ],
                 )
             })
             .clone();
         encoder.clear_buffer(&self.tile_counts, 0, None);
         encoder.clear_buffer(&self.stats, 0, None);
+        encoder.clear_buffer(&self.listed_tiles, 0, Some(4));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("particle light occlusion"),
             timestamp_writes: timestamps,
@@ -151,8 +161,7 @@ impl LightOcclusion {
         pass.set_pipeline(self.pass.pipeline("bin_light_tiles"));
         pass.dispatch_workgroups_indirect(&generator.dispatches, 12);
         pass.set_pipeline(self.pass.pipeline("sort_light_tiles"));
-        let side = tiles.tiles_per_side;
-        pass.dispatch_workgroups(side, side, tiles.levels);
+        pass.dispatch_workgroups(LIGHT_SORT_WORKGROUPS, 1, 1);
         pass.set_pipeline(self.pass.pipeline("walk_light_tiles"));
         pass.dispatch_workgroups_indirect(&generator.dispatches, 12);
     }
@@ -180,12 +189,16 @@ pub static PARTICLE_OCCLUSION_WGSL: crate::shader::WgslModule = crate::shader::w
     occlusion_constants
 );
 
-/// The walk's constants as WGSL (the CPU specification's, `generate.rs`).
+/// The walk's and the sort's constants as WGSL (the CPU specification's, `generate.rs`).
 fn occlusion_constants() -> String {
-    crate::shader::wgsl_consts([(
-        "OCCLUSION_MAX_DEPTH",
-        crate::shader::WgslConst::F32(OCCLUSION_MAX_DEPTH),
-    )])
+    use crate::shader::WgslConst;
+    crate::shader::wgsl_consts([
+        ("OCCLUSION_MAX_DEPTH", WgslConst::F32(OCCLUSION_MAX_DEPTH)),
+        (
+            "LIGHT_SORT_WORKGROUPS",
+            WgslConst::U32(LIGHT_SORT_WORKGROUPS),
+        ),
+    ])
 }
 
 #[cfg(test)]

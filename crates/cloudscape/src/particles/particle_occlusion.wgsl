@@ -1,7 +1,7 @@
 // The seed's light occlusion (particles/occlusion.rs is its specification): the particles binned
 // from the sun into light-space tiles, one level per ring (`bin_light_tiles`, one invocation per
 // particle, listed in the tile of its centre), each tile's list sorted nearest the sun first
-// (`sort_light_tiles`, one workgroup per tile, particle_tiles.wgsl), then each particle walking
+// (`sort_light_tiles`, a workgroup per tile that lists any, particle_tiles.wgsl), then each particle walking
 // the lists of the 3x3 tiles around its ray on its own level and the levels next to it, up to its
 // own place (`walk_light_tiles`), summing the occluders' optical depth until the light left is
 // below 1 %.
@@ -34,6 +34,11 @@ struct LightGrid {
 @group(3) @binding(9) var<storage, read_write> tile_entries: array<u32>;
 // [0] entries beyond a full tile's capacity, [1] particles outside their level.
 @group(3) @binding(10) var<storage, read_write> light_stats: array<atomic<u32>, 2>;
+// The tiles that list a particle: [0] how many, then their indices (bin_light_tiles appends a
+// tile when its first particle arrives), so that the sort visits those alone: most tiles of a
+// level stay empty, and a workgroup per tile of the grid costs more than the sorts themselves
+// where workgroups are expensive to start (llvmpipe's OpenGL: 17 s a frame for the default scene).
+@group(3) @binding(11) var<storage, read_write> listed_tiles: array<atomic<u32>>;
 
 const KEY_INDEX_BITS: u32 = 20u;
 const KEY_INDEX_MASK: u32 = 0xfffffu;
@@ -92,6 +97,10 @@ fn bin_light_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let slot = atomicAdd(&tile_counts[tile], 1u);
+    if slot == 0u {
+        let k = atomicAdd(&listed_tiles[0], 1u);
+        atomicStore(&listed_tiles[k + 1u], u32(tile));
+    }
     if slot < light_grid.tile_capacity {
         tile_entries[u32(tile) * light_grid.tile_capacity + slot] = light_key(p.centre_m, id.x, p.ring);
     } else {
@@ -99,17 +108,27 @@ fn bin_light_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// Sorts each tile's list in place, leaving in tile_counts the entries kept.
+var<workgroup> sort_listed: u32;
+
+// Sorts each listed tile's list in place, leaving in tile_counts the entries kept: workgroup g of
+// LIGHT_SORT_WORKGROUPS sorts listed tiles g, g + LIGHT_SORT_WORKGROUPS, ...
 @compute @workgroup_size(256)
 fn sort_light_tiles(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let n_side = light_grid.tiles_per_side;
-    let tile = (group.z * n_side + group.y) * n_side + group.x;
-    let n = load_sorted_tile(tile, light_grid.tile_capacity, lane);
-    for (var i = lane; i < n; i += TILE_LANES) {
-        tile_entries[tile * light_grid.tile_capacity + i] = tile_keys[i];
-    }
     if lane == 0u {
-        atomicStore(&tile_counts[tile], n);
+        sort_listed = atomicLoad(&listed_tiles[0]);
+    }
+    let listed = workgroupUniformLoad(&sort_listed);
+    for (var k = group.x; k < listed; k += LIGHT_SORT_WORKGROUPS) {
+        let tile = atomicLoad(&listed_tiles[k + 1u]);
+        let n = load_sorted_tile(tile, light_grid.tile_capacity, lane);
+        for (var i = lane; i < n; i += TILE_LANES) {
+            tile_entries[tile * light_grid.tile_capacity + i] = tile_keys[i];
+        }
+        if lane == 0u {
+            atomicStore(&tile_counts[tile], n);
+        }
+        // The next tile's keys overwrite these.
+        workgroupBarrier();
     }
 }
 
