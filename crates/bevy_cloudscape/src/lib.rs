@@ -1,9 +1,11 @@
 #![doc = include_str!("../README.md")]
 
 mod render;
+mod shadow;
 mod sky;
 mod view;
 
+pub use shadow::{CloudShadow, CloudShadowedMaterial};
 pub use sky::{CloudSky, CloudSkyLoader};
 pub use view::Clouds;
 
@@ -12,9 +14,13 @@ pub use cloudscape::scene::{Quality, Scene, Technique};
 
 use bevy::app::{App, Plugin, PostUpdate};
 use bevy::asset::io::file::FileAssetReader;
-use bevy::asset::{AssetApp, AssetPlugin};
+use bevy::asset::{AssetApp, AssetPlugin, Assets};
 use bevy::camera::Camera3d;
 use bevy::ecs::schedule::IntoScheduleConfigs;
+use bevy::pbr::{MaterialPlugin, PbrPlugin};
+use bevy::render::RenderApp;
+use bevy::render::renderer::RenderDevice;
+use bevy::shader::Shader;
 
 /// Clouds over every `Camera3d`: add it to the `App` and each 3-D camera draws the clouds of its
 /// [`Clouds`] component (the embedded default sky unless one is given).
@@ -36,6 +42,35 @@ impl Plugin for CloudscapePlugin {
                 PostUpdate,
                 (view::configure_cameras, view::update_cloud_views).chain(),
             );
+        add_cloud_shadow(app);
         render::build(app);
+    }
+
+    fn finish(&self, app: &mut App) {
+        let generation = app
+            .world()
+            .resource::<shadow::ShadowMapGeneration>()
+            .clone();
+        if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
+            let device = render_app.world().resource::<RenderDevice>();
+            let copy = shadow::ShadowMapCopy::new(device, generation);
+            render_app.insert_resource(copy);
+        }
+    }
+}
+
+/// The clouds' shadow for materials: the shaders, [`CloudShadowedMaterial`] (with Bevy's PBR) and
+/// the systems that keep its bindings current.
+fn add_cloud_shadow(app: &mut App) {
+    if let Some(mut shaders) = app.world_mut().get_resource_mut::<Assets<Shader>>() {
+        shadow::add_shaders(&mut shaders);
+    }
+    app.init_resource::<shadow::ShadowMapGeneration>();
+    if app.is_plugin_added::<PbrPlugin>() {
+        app.add_plugins(MaterialPlugin::<CloudShadowedMaterial>::default())
+            .add_systems(
+                PostUpdate,
+                (shadow::rebind_materials, shadow::warn_unshadowed_sun),
+            );
     }
 }

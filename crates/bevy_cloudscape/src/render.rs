@@ -2,11 +2,13 @@
 //! started in Bevy's prepare stage and recorded into Bevy's encoder between the opaque and the
 //! transparent passes.
 
+use crate::shadow::ShadowMapCopy;
 use crate::view::CloudView;
 use bevy::app::{App, SubApp};
 use bevy::camera::Camera3d;
 use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
 use bevy::core_pipeline::schedule::Core3d;
+use bevy::core_pipeline::schedule::Core3dSystems;
 use bevy::ecs::prelude::*;
 use bevy::ecs::schedule::IntoScheduleConfigs;
 use bevy::log::error;
@@ -41,6 +43,12 @@ fn add_systems(render_app: &mut SubApp) {
         .init_resource::<CloudRenderers>()
         .add_systems(ExtractSchedule, extract_cloud_views)
         .add_systems(
+            Core3d,
+            encode_environment
+                .before(main_opaque_pass_3d)
+                .in_set(Core3dSystems::Prepass),
+        )
+        .add_systems(
             Render,
             begin_cloud_frames
                 .in_set(RenderSystems::Prepare)
@@ -71,6 +79,9 @@ struct CloudRenderers {
     gpu: Option<GpuContext>,
     /// Keyed by the camera's main-world entity.
     views: HashMap<Entity, ViewClouds>,
+    /// The camera whose shadow map materials read: the lowest `Camera::order` among those with
+    /// clouds (then the lowest entity).
+    shadow_source: Option<Entity>,
 }
 
 /// A camera's render entity and its clouds, if any.
@@ -109,6 +120,11 @@ fn begin_cloud_frames(
         )
     });
     let mut seen = HashSet::new();
+    renderers.shadow_source = views
+        .iter()
+        .map(|(main, .., camera)| (camera.order, main))
+        .min()
+        .map(|(_, main)| main);
     for (main, cloud_view, view, camera) in &views {
         seen.insert(main);
         let Some(size) = camera.physical_target_size.filter(|s| s.x > 0 && s.y > 0) else {
@@ -193,6 +209,32 @@ fn frame_of(cloud_view: &CloudView, view: &ExtractedView, size: glam::UVec2, ind
         time_s: cloud_view.time_s,
         exposure_ev: 0.0,
         frame_index: index,
+    }
+}
+
+/// Records the frame's environment passes (the clouds' shadow map, the sky's tables) before Bevy's
+/// opaque pass, and copies the shadow map that materials read out of the source camera's.
+fn encode_environment(
+    view: ViewQuery<MainEntity, With<CloudView>>,
+    mut renderers: ResMut<CloudRenderers>,
+    mut copy: ResMut<ShadowMapCopy>,
+    (device, queue): (Res<RenderDevice>, Res<RenderQueue>),
+    mut ctx: RenderContext,
+) {
+    let main = view.into_inner();
+    let renderers = &mut *renderers;
+    let (Some(gpu), Some(clouds)) = (&renderers.gpu, renderers.views.get_mut(&main)) else {
+        return;
+    };
+    if !clouds.begun {
+        return;
+    }
+    let encoder = ctx.command_encoder();
+    clouds.renderer.encode_environment(gpu, encoder, None);
+    if renderers.shadow_source == Some(main)
+        && let Some(map) = clouds.renderer.shadow_map()
+    {
+        copy.update(&device, &queue, encoder, map);
     }
 }
 

@@ -1,8 +1,10 @@
 //! A scene file edited on disk while the app runs reaches the next frames: the flight world's
-//! balloon, in a clear sky, disappears once its sky file is rewritten as an overcast deck.
+//! balloon, in a clear sky, disappears once its sky file is rewritten as an overcast deck, and the
+//! deck's shadow falls on the towers' `CloudShadowedMaterial`.
 
 mod harness;
 
+use bevy::math::Vec3;
 use harness::{Step, color_around, needs, redness, world};
 use std::path::Path;
 
@@ -35,6 +37,7 @@ fn an_edited_scene_file_reaches_the_next_frames() {
     // pales it: measured 1.64), hidden by the deck (the deck's grey: 1.0-1.1).
     let balloon = |i: usize| redness(color_around(&shots[i], world::BALLOON, 0.015));
     let (before, after) = (balloon(0), balloon(1));
+    let (clear_face, overcast_face) = (sunlit_face(&shots[0]), sunlit_face(&shots[1]));
     eprintln!("the balloon's red over green and blue: {before:.2} clear, {after:.2} overcast");
     assert!(
         before > 1.4,
@@ -45,4 +48,26 @@ fn an_edited_scene_file_reaches_the_next_frames() {
         "after the file changed to an overcast deck the balloon still shows (red over green and \
          blue {after:.2} before {before:.2}): the edit did not reach the frames"
     );
+    // The deck (optical depth in the hundreds) takes the sun off the face; Bevy's ambient light
+    // and the haze in front are what is left.
+    eprintln!("the tower's sunlit face: {clear_face:.3} clear, {overcast_face:.3} overcast");
+    assert!(
+        clear_face > 0.25,
+        "under the clear sky the sunlit face of the tower is dark ({clear_face:.3})"
+    );
+    assert!(
+        overcast_face < 0.3 * clear_face,
+        "under the overcast deck the tower's sunlit face is {overcast_face:.3}, {:.2} of its \
+         {clear_face:.3} under the clear sky: the clouds cast no shadow on the material",
+        overcast_face / clear_face
+    );
+}
+
+/// The mean brightness (0-1, of the tone-mapped colour's channels) of the tallest concrete
+/// tower's face toward the camera, which the sun behind the camera lights.
+fn sunlit_face(shot: &cloudscape::image::LdrImage) -> f32 {
+    let (x, z, half, height) = world::CONCRETE_TOWERS[1];
+    let face = Vec3::new(x, 0.5 * height, z + half);
+    let color = color_around(shot, face, 0.03);
+    (color.x + color.y + color.z) / 3.0
 }

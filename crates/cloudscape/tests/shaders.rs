@@ -7,6 +7,7 @@ use cloudscape::field::gpu::FIELD_WGSL;
 use cloudscape::frame::FRAME_WGSL;
 use cloudscape::renderer::PROGRAMS;
 use cloudscape::shader::{ENVIRONMENT_GROUP, FIELD_GROUP, FRAME_GROUP, Program, WgslModule};
+use cloudscape::shadow::SHADOW_MAP_WGSL;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
@@ -97,4 +98,23 @@ fn a_host_shader_reaches_the_cloud_shadow() {
     let broken = Program::host(&[&ENVIRONMENT_WGSL], "fn f() -> f32 { return nope; }\n");
     let error = broken.validate().expect_err("nope is undefined");
     assert!(error.to_string().starts_with("host source:1:"), "{error}");
+}
+
+#[test]
+fn a_host_shader_reads_the_shadow_map_bound_in_its_own_group() {
+    let host = "struct HostShadow { map: CloudShadow, sun: vec4<f32> }\n\
+        @group(3) @binding(0) var<uniform> host_shadow: HostShadow;\n\
+        @group(3) @binding(1) var host_map: texture_2d_array<f32>;\n\
+        @group(3) @binding(2) var host_linear: sampler;\n\
+        @fragment fn host_fs(@location(0) p: vec3<f32>) -> @location(0) vec4<f32> {\n\
+            let tau = cloud_shadow_sun_optical_depth(host_shadow.map, host_map, host_linear, host_shadow.sun.xyz, p);\n\
+            return vec4<f32>(vec3<f32>(exp(-tau)), 1.0);\n\
+        }\n";
+    let program = Program::host(&[&SHADOW_MAP_WGSL], host);
+    assert_eq!(
+        program.groups(),
+        Vec::<u32>::new(),
+        "the module binds nothing"
+    );
+    program.validate().unwrap_or_else(|e| panic!("{e}"));
 }

@@ -6,7 +6,8 @@
 //! C/V less and more cloud; T/G the sun up and down; 1/2/3 ray marcher, particles, sprites;
 //! Space pauses the clouds' clock. The sky is `assets/sky.toml`: edit it while flying.
 //!
-//! `-- --screenshot OUT.png [--size WxH]` saves the window after 60 frames and exits;
+//! `-- --screenshot OUT.png [--size WxH] [--view ALTITUDE_M,PITCH_DEG]` saves the window after 60
+//! frames and exits (`--view`: start at that height, pitched up by that angle, negative down);
 //! `-- --bench N [--size WxH] [--cold-lighting]` times N frames with the clouds and N without,
 //! and prints both (`--cold-lighting`: the clouds' lighting rebuilt every frame, as `cloudscape
 //! bench` does).
@@ -15,7 +16,7 @@ mod world;
 
 use bevy::prelude::*;
 use bevy::render::view::screenshot::Screenshot;
-use bevy_cloudscape::{CloudSky, Clouds, CloudscapePlugin, Technique};
+use bevy_cloudscape::{CloudShadowedMaterial, CloudSky, Clouds, CloudscapePlugin, Technique};
 
 /// The line of help, in the window's title.
 const HELP: &str = "cloudscape | WASD QE fly, arrows turn, Shift fast | C/V cloud -/+ | T/G sun | \
@@ -56,6 +57,8 @@ struct Options {
     bench: Option<u32>,
     /// Rebuild the clouds' lighting every frame.
     cold_lighting: bool,
+    /// Start at this height (metres), pitched up by this angle (degrees; negative: down).
+    view: Option<(f32, f32)>,
 }
 
 /// Frames before `--screenshot` saves the window (and before `--bench` starts timing).
@@ -74,6 +77,14 @@ impl Options {
                 "--screenshot" => options.screenshot = Some(value()),
                 "--bench" => options.bench = Some(value().parse().expect("--bench N")),
                 "--cold-lighting" => options.cold_lighting = true,
+                "--view" => {
+                    let v = value();
+                    let (altitude, pitch) = v.split_once(',').expect("--view ALTITUDE_M,PITCH_DEG");
+                    options.view = Some((
+                        altitude.parse().expect("altitude"),
+                        pitch.parse().expect("pitch"),
+                    ));
+                }
                 "--size" => {
                     let v = value();
                     let (w, h) = v.split_once('x').expect("--size WxH");
@@ -92,15 +103,20 @@ fn run_options(
     mut commands: Commands,
     options: Res<Options>,
     time: Res<Time<Real>>,
-    mut clouds: Query<&mut Clouds>,
+    mut cameras: Query<(&mut Clouds, &mut Transform)>,
     mut exit: MessageWriter<AppExit>,
     mut frame: Local<u32>,
     mut timed: Local<Vec<f32>>,
 ) {
     *frame += 1;
-    if *frame == 1 && options.cold_lighting {
-        for mut c in &mut clouds {
-            c.reuse_lighting = false;
+    if *frame == 1 {
+        for (mut clouds, mut transform) in &mut cameras {
+            clouds.reuse_lighting = !options.cold_lighting;
+            if let Some((altitude, pitch)) = options.view {
+                let pitch = pitch.to_radians();
+                *transform = Transform::from_xyz(0.0, altitude, 0.0)
+                    .looking_to(Vec3::new(0.0, pitch.sin(), -pitch.cos()), Vec3::Y);
+            }
         }
     }
     if let Some(path) = options
@@ -120,8 +136,8 @@ fn run_options(
         timed.push(time.delta_secs() * 1000.0);
     }
     if timed.len() == n as usize {
-        for mut c in &mut clouds {
-            c.enabled = false;
+        for (mut clouds, _) in &mut cameras {
+            clouds.enabled = false;
         }
     }
     if timed.len() == 2 * n as usize + SCREENSHOT_FRAME as usize / 4 {
@@ -142,11 +158,16 @@ fn run_options(
 fn setup(
     mut commands: Commands,
     mut meshes: ResMut<Assets<Mesh>>,
-    mut materials: ResMut<Assets<StandardMaterial>>,
+    mut standard: ResMut<Assets<StandardMaterial>>,
+    mut shadowed: ResMut<Assets<CloudShadowedMaterial>>,
     assets: Res<AssetServer>,
 ) {
     let sky = assets.load::<CloudSky>("sky.toml");
-    world::spawn_world(&mut commands, &mut meshes, &mut materials, sky);
+    let materials = world::Materials {
+        standard: &mut standard,
+        shadowed: &mut shadowed,
+    };
+    world::spawn_world(&mut commands, &mut meshes, materials, sky);
 }
 
 /// WASD QE moves the camera along its own axes, the arrows turn it.

@@ -2,8 +2,9 @@
 //! sun and a camera with clouds. Shared with the tests, which render it in a window.
 
 use bevy::camera::Exposure;
+use bevy::light::CascadeShadowConfigBuilder;
 use bevy::prelude::*;
-use bevy_cloudscape::{CloudSky, Clouds};
+use bevy_cloudscape::{CloudShadowedMaterial, CloudSky, Clouds};
 
 /// Where the camera starts, metres.
 pub const START: Vec3 = Vec3::new(0.0, 40.0, 0.0);
@@ -27,32 +28,57 @@ pub fn start_transform() -> Transform {
     Transform::from_translation(START).looking_to(Vec3::new(0.0, 0.35, -1.0), Vec3::Y)
 }
 
+/// The ground's colour: what the tests compare under a clear and an overcast sky.
+pub const GROUND_COLOR: Color = Color::srgb(0.30, 0.34, 0.22);
+/// The concrete towers beyond the red one: x and z of the centre, half-width and height, metres.
+/// The sun (behind the camera) lights their faces toward the camera.
+pub const CONCRETE_TOWERS: [(f32, f32, f32, f32); 3] = [
+    (-260.0, -700.0, 40.0, 180.0),
+    (300.0, -900.0, 60.0, 260.0),
+    (-600.0, -1400.0, 80.0, 140.0),
+];
+/// The concrete towers' colour.
+pub const CONCRETE_COLOR: Color = Color::srgb(0.55, 0.53, 0.5);
+
+/// Where the world's materials go: the unlit markers are Bevy's `StandardMaterial`, the lit ground
+/// and towers a `CloudShadowedMaterial` (the clouds' shadow falls on them).
+pub struct Materials<'a> {
+    /// Bevy's own.
+    pub standard: &'a mut Assets<StandardMaterial>,
+    /// Under the clouds' shadow.
+    pub shadowed: &'a mut Assets<CloudShadowedMaterial>,
+}
+
+/// A lit material of `color` and `roughness` under the clouds' shadow.
+fn shadowed(color: Color, roughness: f32) -> CloudShadowedMaterial {
+    CloudShadowedMaterial {
+        base: StandardMaterial {
+            base_color: color,
+            perceptual_roughness: roughness,
+            ..default()
+        },
+        extension: default(),
+    }
+}
+
 /// Spawns the world, the sun and a camera whose clouds are `sky`.
 pub fn spawn_world(
     commands: &mut Commands,
     meshes: &mut Assets<Mesh>,
-    materials: &mut Assets<StandardMaterial>,
+    materials: Materials,
     sky: Handle<CloudSky>,
 ) {
-    let ground = materials.add(StandardMaterial {
-        base_color: Color::srgb(0.30, 0.34, 0.22),
-        perceptual_roughness: 1.0,
-        ..default()
-    });
+    let Materials {
+        standard,
+        shadowed: lit,
+    } = materials;
+    let ground = lit.add(shadowed(GROUND_COLOR, 1.0));
     commands.spawn((
         Mesh3d(meshes.add(Plane3d::default().mesh().size(60_000.0, 60_000.0))),
         MeshMaterial3d(ground),
     ));
-    let concrete = materials.add(StandardMaterial {
-        base_color: Color::srgb(0.55, 0.53, 0.5),
-        perceptual_roughness: 0.9,
-        ..default()
-    });
-    for (x, z, half, height) in [
-        (-260.0, -700.0, 40.0, 180.0),
-        (300.0, -900.0, 60.0, 260.0),
-        (-600.0, -1400.0, 80.0, 140.0),
-    ] {
+    let concrete = lit.add(shadowed(CONCRETE_COLOR, 0.9));
+    for (x, z, half, height) in CONCRETE_TOWERS {
         commands.spawn((
             Mesh3d(meshes.add(Cuboid::new(2.0 * half, height, 2.0 * half))),
             MeshMaterial3d(concrete.clone()),
@@ -67,20 +93,28 @@ pub fn spawn_world(
     let (centre, half) = TOWER;
     commands.spawn((
         Mesh3d(meshes.add(Cuboid::new(2.0 * half.x, 2.0 * half.y, 2.0 * half.z))),
-        MeshMaterial3d(materials.add(unlit(TOWER_COLOR))),
+        MeshMaterial3d(standard.add(unlit(TOWER_COLOR))),
         Transform::from_translation(centre + Vec3::Y * half.y),
     ));
     commands.spawn((
         Mesh3d(meshes.add(Sphere::new(BALLOON_RADIUS_M))),
-        MeshMaterial3d(materials.add(unlit(TOWER_COLOR))),
+        MeshMaterial3d(standard.add(unlit(TOWER_COLOR))),
         Transform::from_translation(BALLOON),
     ));
     commands.spawn((
         DirectionalLight {
             illuminance: light_consts::lux::RAW_SUNLIGHT,
-            shadow_maps_enabled: false,
+            // Bevy applies the clouds' shadow to a light with shadow maps.
+            shadow_maps_enabled: true,
             ..default()
         },
+        // The towers' shadows near the camera; the clouds' shadow reaches the far distance.
+        CascadeShadowConfigBuilder {
+            num_cascades: 2,
+            maximum_distance: 3000.0,
+            ..default()
+        }
+        .build(),
         sun_transform(35.0, 200.0),
     ));
     commands.spawn((

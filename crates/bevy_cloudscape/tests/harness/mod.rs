@@ -8,7 +8,7 @@ use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy::window::WindowResolution;
 use bevy::winit::WinitPlugin;
-use bevy_cloudscape::{CloudSky, Clouds, CloudscapePlugin};
+use bevy_cloudscape::{CloudShadowedMaterial, CloudSky, Clouds, CloudscapePlugin};
 use cloudscape::image::LdrImage;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -113,12 +113,17 @@ struct Script {
 fn setup(
     mut commands: Commands,
     mut meshes: ResMut<Assets<Mesh>>,
-    mut materials: ResMut<Assets<StandardMaterial>>,
+    mut standard: ResMut<Assets<StandardMaterial>>,
+    mut shadowed: ResMut<Assets<CloudShadowedMaterial>>,
     assets: Res<AssetServer>,
     sky: Res<SkyFile>,
 ) {
     let sky = assets.load::<CloudSky>(sky.0.clone());
-    world::spawn_world(&mut commands, &mut meshes, &mut materials, sky);
+    let materials = world::Materials {
+        standard: &mut standard,
+        shadowed: &mut shadowed,
+    };
+    world::spawn_world(&mut commands, &mut meshes, materials, sky);
 }
 
 /// Moves the script on by at most one step a frame; exits the app at its end.

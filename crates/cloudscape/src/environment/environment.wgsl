@@ -3,19 +3,6 @@
 // sky_model 1 they read the atmosphere's tables (Hillaire 2020); otherwise the analytic gradient
 // or constant sky. The twin of environment::Environment.
 
-struct CloudShadow {
-    centre_m: vec2<f32>,       // world xz of the map's centre (under the viewpoint)
-    half_extent_m: f32,        // the map reaches this far from its centre on the ground plane
-    warp: f32,                 // texel size at the centre over the mean texel size (1: no warp)
-    bottom_y_m: f32,           // world y below which the whole cloud column lies above
-    top_y_m: f32,              // world y above which no cloud lies
-    sun_y: f32,                // sun direction's y, at least SHADOW_MIN_SUN_Y
-    enabled: u32,              // 0: no clouds, the map reads zero
-    steps_per_checkpoint: u32, // samples of the coarse field between two checkpoints
-    pad0: u32,
-    pad: vec2<u32>,
-}
-
 // The light volume's cascades (environment/light_volume, LightVolumeUniform).
 struct LightVolume {
     cascade_min_m: array<vec4<f32>, LIGHT_VOLUME_MAX_CASCADES>,  // lowest corner (xyz) of each
@@ -235,50 +222,27 @@ fn environment_aerial_texel_uv(uv: vec2<f32>, k: f32) -> vec2<f32> {
     return vec2<f32>((k * size.x + texel.x) / (size.x * f32(ATMOSPHERE_AERIAL_SLICES)), texel.y / size.y);
 }
 
-// Texel coordinate in [-1, 1] of ground-plane offset x (in half extents, -1..1) in the warped
-// cloud-shadow map: the inverse of x = s (k + (1 - k) |s|), k the warp (CloudShadowMap::texel_of).
-// Branch-free on purpose: lavapipe (Mesa 22.3) recompiles a shader with a branch on uniform values
-// alone whenever those values change, and leaks each compilation (docs/hardening.md, "Soak").
-fn environment_shadow_coord(x: f32) -> f32 {
-    let k = environment.shadow.warp;
-    let a = abs(x);
-    let warped = (-k + sqrt(k * k + 4.0 * (1.0 - k) * a)) / (2.0 * max(1.0 - k, 1e-6));
-    return sign(x) * select(a, warped, k < 1.0);
-}
-
-// Ground-plane offset (in half extents) of texel coordinate s: x = s (k + (1 - k) |s|), fine texels
-// near the viewpoint and coarse ones far away (CloudShadowMap::offset_of).
+// Ground-plane offset (in half extents) of texel coordinate s of the environment's shadow map.
 fn environment_shadow_offset(s: f32) -> f32 {
-    let k = environment.shadow.warp;
-    return s * (k + (1.0 - k) * abs(s));
+    return cloud_shadow_offset(s, environment.shadow.warp);
 }
 
-// Cloud optical depth above height y from the map's four checkpoints (rgba at bottom + 0, 1/4, 1/2
-// and 3/4 of the span; zero at its top), read in `layer` at ground-plane point g: linear between
-// checkpoints (CloudShadowMap::optical_depth).
+// Cloud optical depth above height y at ground-plane point g, from `layer` of the environment's
+// shadow map (cloud_shadow_read).
 fn environment_shadow_read(g: vec2<f32>, y: f32, layer: i32) -> f32 {
-    let s = environment.shadow;
-    if s.enabled == 0u || y >= s.top_y_m {
-        return 0.0;
-    }
-    let x = (g - s.centre_m) / s.half_extent_m;
-    if any(abs(x) > vec2<f32>(1.0)) {
-        return 0.0;
-    }
-    let coord = vec2<f32>(environment_shadow_coord(x.x), environment_shadow_coord(x.y));
-    let checkpoints = textureSampleLevel(environment_cloud_shadow, environment_linear, coord * 0.5 + 0.5, layer, 0.0);
-    let f = clamp((y - s.bottom_y_m) / (s.top_y_m - s.bottom_y_m), 0.0, 1.0) * 4.0;
-    var values = array<f32, 5>(checkpoints.x, checkpoints.y, checkpoints.z, checkpoints.w, 0.0);
-    let i = min(u32(f), 3u);
-    return mix(values[i], values[i + 1u], f - f32(i));
+    return cloud_shadow_read(environment.shadow, environment_cloud_shadow, environment_linear, g, y, layer);
 }
 
 // Optical depth of the clouds between world point p and the sun, from the shared light-space map
 // (its ground-plane projection along the sun): for hosts' geometry, the ground and the air.
 fn environment_cloud_sun_optical_depth(p: vec3<f32>) -> f32 {
-    let s = environment.shadow;
-    let g = p.xz - environment.sun_direction.xz * (p.y / s.sun_y);
-    return environment_shadow_read(g, p.y, 0);
+    return cloud_shadow_sun_optical_depth(
+        environment.shadow,
+        environment_cloud_shadow,
+        environment_linear,
+        environment.sun_direction,
+        p,
+    );
 }
 
 // Optical depth of the clouds straight above world point p, from the map: what dims the sky's

@@ -53,7 +53,8 @@ impl AirUniform {
     }
 }
 
-/// GPU layout of [`ShadowParams`]: the `CloudShadow` struct of `environment.wgsl`.
+/// GPU layout of [`ShadowParams`]: the `CloudShadow` struct of `shadow_map.wgsl`
+/// ([`crate::shadow::SHADOW_MAP_WGSL`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct CloudShadowUniform {
@@ -447,11 +448,12 @@ impl EnvironmentGpu {
         }
     }
 
-    /// The light volume's table, which its pass fills by a copy: GL binds a 3-D storage texture
-    /// one slice at a time (wgpu's GL backend binds a single-layer view unlayered), so a compute
-    /// pass cannot write all of it.
-    pub fn light_volume_texture(&self) -> &wgpu::Texture {
-        &self.textures[EnvironmentTable::LightVolume.bindings()[0] - 1]
+    /// The texture of `table`: the light volume's pass fills its table by a copy (GL binds a 3-D
+    /// storage texture one slice at a time: wgpu's GL backend binds a single-layer view
+    /// unlayered, so a compute pass cannot write all of it), and a host copies the clouds' shadow
+    /// map out of its table.
+    pub fn texture(&self, table: EnvironmentTable) -> &wgpu::Texture {
+        &self.textures[table.bindings()[0] - 1]
     }
 
     /// The storage views of `table` ([`EnvironmentTable`]'s outputs, in binding order).
@@ -526,7 +528,8 @@ pub static ENVIRONMENT_WGSL: crate::shader::WgslModule = crate::shader::wgsl_mod
     "environment.wgsl",
     [
         &crate::shader::MATH_WGSL,
-        &crate::atmosphere::ATMOSPHERE_WGSL
+        &crate::atmosphere::ATMOSPHERE_WGSL,
+        &crate::shadow::SHADOW_MAP_WGSL
     ],
     environment_constants
 );

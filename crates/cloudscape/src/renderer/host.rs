@@ -14,8 +14,8 @@ use crate::environment::light_volume::{
     CELL_SLICES, DiffuseOptics, LightVolumeGrid, LightVolumeSettings,
 };
 use crate::environment::{
-    Environment, EnvironmentGpu, EnvironmentPasses, EnvironmentUniform, LightVolumeUniform, Sky,
-    TableSizes,
+    CloudShadowUniform, Environment, EnvironmentGpu, EnvironmentPasses, EnvironmentTable,
+    EnvironmentUniform, LightVolumeUniform, Sky, TableSizes,
 };
 pub use crate::field::gpu::FieldUpdate;
 
@@ -29,7 +29,7 @@ use crate::pass::Shared;
 use crate::post::upsample::Upsampler;
 use crate::post::{Background, Compositor, DISPLAY_FORMAT, Display, HDR_FORMAT};
 use crate::scene::Scene;
-use crate::shadow::{BuiltShadow, LightingReuse, ShadowParams};
+use crate::shadow::{BuiltShadow, LightingReuse, ShadowMapBinding, ShadowParams};
 use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use crate::temporal::{TemporalResolve, TemporalSettings};
 use glam::{UVec2, Vec2};
@@ -272,6 +272,19 @@ impl CloudRenderer {
             self.environment_gpu.layout(),
             self.environment_gpu.bind_group(),
         )
+    }
+
+    /// The clouds' shadow map of the frame last begun, for a host's shaders that bind it in a
+    /// group of their own (a game engine's materials): valid in the encoder once
+    /// [`CloudRenderer::encode_environment`] (or [`CloudRenderer::encode_clouds`]) has recorded
+    /// the frame's passes. None before the first frame.
+    pub fn shadow_map(&self) -> Option<ShadowMapBinding<'_>> {
+        let built = self.shadow_built.as_ref()?;
+        Some(ShadowMapBinding {
+            texture: self.environment_gpu.texture(EnvironmentTable::CloudShadow),
+            params: CloudShadowUniform::new(&built.params),
+            sun_direction: self.environment.0.sun.direction,
+        })
     }
 
     /// The shared groups, for passes a host adds (probes, its own effects).

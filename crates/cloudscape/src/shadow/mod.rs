@@ -10,8 +10,11 @@
 //! coarse optical depth from four checkpoint heights (`bottom + 0, 1/4, 1/2, 3/4` of the clouds'
 //! height span) to the top; between checkpoints the depth is linear in height. A point is shadowed
 //! by reading the column through it: `environment_cloud_sun_optical_depth(p)` in
-//! `environment.wgsl`, which [`CloudShadowMap::optical_depth`] specifies.
+//! `environment.wgsl`, which [`CloudShadowMap::optical_depth`] specifies, through
+//! [`SHADOW_MAP_WGSL`]'s functions, which a host's own shaders import to read the map bound in
+//! their own group ([`ShadowMapBinding`]).
 
+use crate::environment::CloudShadowUniform;
 use crate::field::CloudField;
 use crate::scene::{PlanetShape, Scene};
 use glam::{Vec2, Vec3};
@@ -77,13 +80,13 @@ impl ShadowParams {
     }
 
     /// Ground-plane offset in half extents of texel coordinate `s` in `[-1, 1]`:
-    /// `s (k + (1 - k) |s|)` (`environment_shadow_offset`).
+    /// `s (k + (1 - k) |s|)` (`cloud_shadow_offset`).
     pub fn offset_of(&self, s: f32) -> f32 {
         s * (self.warp + (1.0 - self.warp) * s.abs())
     }
 
     /// Texel coordinate of ground-plane offset `x` in half extents: the inverse of
-    /// [`ShadowParams::offset_of`] (`environment_shadow_coord`).
+    /// [`ShadowParams::offset_of`] (`cloud_shadow_coord`).
     pub fn coord_of(&self, x: f32) -> f32 {
         let (k, a) = (self.warp, x.abs());
         let s = if k < 1.0 {
@@ -147,7 +150,7 @@ impl ShadowParams {
     }
 
     /// Optical depth above height `y` in a column's checkpoints: linear between them, zero at
-    /// and above the top (`environment_shadow_read`).
+    /// and above the top (`cloud_shadow_read`).
     pub fn depth_above(&self, column: [f32; CHECKPOINTS], y: f32) -> f32 {
         if !self.enabled || y >= self.top_y_m {
             return 0.0;
@@ -233,7 +236,7 @@ pub(crate) fn cloud_heights(field: &CloudField) -> (f32, f32, bool) {
     }
 }
 
-/// The map on the CPU: the specification of the GPU pass and of `environment_shadow_read`.
+/// The map on the CPU: the specification of the GPU pass and of `cloud_shadow_read`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CloudShadowMap {
     /// Where it lies.
@@ -297,3 +300,25 @@ impl CloudShadowMap {
 
 #[cfg(test)]
 mod tests;
+
+/// Reading the map in WGSL (`shadow_map.wgsl`): the `CloudShadow` struct (where the map lies, as
+/// [`CloudShadowUniform`] lays it out) and `cloud_shadow_sun_optical_depth(s, map, sampler, sun,
+/// p)`, with the map, a filtering sampler and the sun as arguments, so that the environment and a
+/// host's shaders read the map by the same code wherever it is bound.
+pub static SHADOW_MAP_WGSL: crate::shader::WgslModule =
+    crate::shader::wgsl_module!("shadow_map", "shadow_map.wgsl", []);
+
+/// The frame's map as a host binds it in its own shaders ([`SHADOW_MAP_WGSL`]):
+/// [`crate::renderer::CloudRenderer::shadow_map`].
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowMapBinding<'a> {
+    /// The map: a 2-D array of two layers (the columns along the sun, then straight up), each
+    /// texel's four checkpoints' optical depths in rgba, in
+    /// [`crate::environment::EnvironmentGpu`]'s table format. Filled by the frame's environment
+    /// passes: copy or bind it after them.
+    pub texture: &'a wgpu::Texture,
+    /// Where the map lies: `CloudShadow` of `shadow_map.wgsl`.
+    pub params: CloudShadowUniform,
+    /// Unit vector toward the frame's sun, world space (`sun_direction` of the read).
+    pub sun_direction: Vec3,
+}

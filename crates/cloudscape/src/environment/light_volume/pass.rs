@@ -166,7 +166,7 @@ impl LightVolumePass {
         copy_table(
             encoder,
             &buffers[3],
-            environment.light_volume_texture(),
+            environment.texture(EnvironmentTable::LightVolume),
             grid,
         );
         self.solved = Some(grid.clone());
