@@ -144,7 +144,7 @@ fn begin_cloud_frames(
                 divisor,
                 ..TemporalSettings::default()
             }),
-            None => Reuse::None,
+            None => Reuse::Scaled(cloud_view.scale_divisor),
         };
         let lighting = cloud_view
             .reuse_lighting

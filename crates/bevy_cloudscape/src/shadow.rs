@@ -22,8 +22,9 @@ use bevy::render::render_resource::{
 };
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::shader::{Shader, ShaderRef};
+use cloudscape::environment::ShadowMapBinding;
 use cloudscape::shader::Program;
-use cloudscape::shadow::{SHADOW_MAP_WGSL, ShadowMapBinding};
+use cloudscape::shadow::SHADOW_MAP_WGSL;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 

@@ -35,6 +35,11 @@ pub struct Clouds {
     /// Temporal reuse: march one ray per `n x n` pixels a frame (2 or 4) and reproject the rest
     /// from the last frames; None marches every pixel every frame.
     pub temporal_grid: Option<u32>,
+    /// Without temporal reuse, the fraction of the view's resolution the clouds are marched at:
+    /// 1 (the default), 1/2 or 1/4 (others round to the nearest 1/n), then upsampled to the view
+    /// against its depth. With temporal reuse the grid is the scale (one ray per `n x n` pixels a
+    /// frame, the history at the view's resolution) and this is not read.
+    pub render_scale: f32,
     /// Carry the lighting across frames as a game does (`LightingReuse::REAL_TIME`: the clouds'
     /// shadow map kept until the eye and the wind have moved half of its finest texel, the light
     /// volume warm-started); false rebuilds both every frame.
@@ -49,6 +54,7 @@ impl Default for Clouds {
             technique: None,
             quality: None,
             temporal_grid: Some(4),
+            render_scale: 1.0,
             reuse_lighting: true,
         }
     }
@@ -84,6 +90,9 @@ pub(crate) struct CloudView {
     pub sky: SkyScene,
     /// Temporal reuse's grid (None: every pixel every frame).
     pub temporal_grid: Option<u32>,
+    /// Without temporal reuse, one ray per this many pixels along x and y (the render scale's
+    /// inverse).
+    pub scale_divisor: u32,
     /// Whether the lighting is carried across frames.
     pub reuse_lighting: bool,
     /// The sun: the first `DirectionalLight`, in the camera's exposed units.
@@ -190,6 +199,7 @@ pub(crate) fn update_cloud_views(
         commands.entity(entity).insert(CloudView {
             sky,
             temporal_grid: clouds.temporal_grid,
+            scale_divisor: (1.0 / clouds.render_scale.clamp(0.125, 1.0)).round() as u32,
             reuse_lighting: clouds.reuse_lighting,
             sun,
             time_s: time.elapsed_secs(),

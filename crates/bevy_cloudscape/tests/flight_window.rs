@@ -22,16 +22,30 @@ use std::sync::OnceLock;
 /// Frames before the screenshot: Bevy's pipelines compiled and the scene drawn.
 const WARMUP_FRAMES: u32 = 30;
 
-/// The screenshot of the flight world under `tests/assets/overcast.toml`, taken once for every
-/// test of this file (a process opens one window event loop); None without Xvfb (outside CI).
+/// The screenshots of the flight world under `tests/assets/overcast.toml`, taken once for every
+/// test of this file (a process opens one window event loop): at the full render scale, then at
+/// 1/2; None without Xvfb (outside CI).
+fn screenshots() -> Option<&'static [LdrImage; 2]> {
+    static SHOTS: OnceLock<Option<[LdrImage; 2]>> = OnceLock::new();
+    SHOTS
+        .get_or_init(|| {
+            let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/assets");
+            let script = vec![
+                Step::Frames(WARMUP_FRAMES),
+                Step::Screenshot,
+                Step::RenderScale(0.5),
+                Step::Frames(3),
+                Step::Screenshot,
+            ];
+            let shots = harness::run(&assets, "overcast.toml", script)?;
+            Some(shots.try_into().expect("two screenshots"))
+        })
+        .as_ref()
+}
+
+/// The screenshot at the full render scale.
 fn screenshot() -> Option<&'static LdrImage> {
-    static SHOT: OnceLock<Option<LdrImage>> = OnceLock::new();
-    SHOT.get_or_init(|| {
-        let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/assets");
-        let script = vec![Step::Frames(WARMUP_FRAMES), Step::Screenshot];
-        harness::run(&assets, "overcast.toml", script).map(|mut shots| shots.remove(0))
-    })
-    .as_ref()
+    screenshots().map(|shots| &shots[0])
 }
 
 #[test]
@@ -53,6 +67,33 @@ fn the_tower_in_front_hides_the_clouds() {
         "the tower in front of the clouds shows {color} (red over green and blue {:.2}): \
          the clouds were drawn over it",
         redness(color)
+    );
+}
+
+#[test]
+fn at_half_the_render_scale_the_window_barely_changes() {
+    let Some([full, half]) = screenshots() else {
+        return;
+    };
+    let (stats, _) = cloudscape::image::flip(full, half).expect("same size");
+    eprintln!(
+        "FLIP of the half render scale against the full: mean {:.4}",
+        stats.mean
+    );
+    assert!(
+        stats.mean < 0.03,
+        "at a render scale of 1/2 the window differs from the full scale by FLIP {:.4}",
+        stats.mean
+    );
+    assert!(
+        stats.mean > 1e-4,
+        "the window at a render scale of 1/2 is the full scale's: the scale was not applied"
+    );
+    let (base, half_size) = world::TOWER;
+    let color = color_around(half, base + Vec3::Y * (1.8 * half_size.y), 0.02);
+    assert!(
+        redness(color) > 2.0,
+        "at a render scale of 1/2 the clouds were drawn over the tower in front ({color})"
     );
 }
 

@@ -2,6 +2,10 @@
 //! balloon, in a clear sky, disappears once its sky file is rewritten as an overcast deck, and the
 //! deck's shadow falls on the towers' `CloudShadowedMaterial`.
 
+#[allow(
+    dead_code,
+    reason = "the harness's render scale serves the window test"
+)]
 mod harness;
 
 use bevy::math::Vec3;

@@ -24,16 +24,16 @@ fn renderer(ctx: &GpuContext, technique: Technique) -> CloudRenderer {
     CloudRenderer::new(ctx, &overcast(technique), std::path::Path::new(".")).expect("field")
 }
 
-/// Begins a frame of `convention` at 64x36 on `clouds`, which draws `technique`.
+/// Begins a frame of `convention` at 64x36 on `clouds`, which draws `technique` with `reuse`.
 fn begin(
     ctx: &GpuContext,
     clouds: &mut CloudRenderer,
     convention: DepthConvention,
-    technique: Technique,
+    (technique, reuse): (Technique, Reuse),
 ) -> Frame {
     let scene = overcast(technique);
     let frame = Frame::from_scene(&scene, UVec2::new(64, 36)).with_depth(&scene, convention);
-    clouds.begin_frame(ctx, &frame, Reuse::None);
+    clouds.begin_frame(ctx, &frame, reuse);
     frame
 }
 
@@ -66,9 +66,9 @@ fn clouds_over_depth(
     clouds: &mut CloudRenderer,
     convention: DepthConvention,
     wall_m: Option<f32>,
-    technique: Technique,
+    drawn: (Technique, Reuse),
 ) -> (f32, f32) {
-    let frame = begin(ctx, clouds, convention, technique);
+    let frame = begin(ctx, clouds, convention, drawn);
     let depth = wall_m.map_or(convention.far_value(), |d| {
         convention.depth_of_distance(&frame.clip_from_view, d)
     });
@@ -95,7 +95,7 @@ fn geometry_hides_the_clouds(technique: Technique, max_clear_transmittance: f32)
     let mut clouds = renderer(&ctx, technique);
     for convention in DepthConvention::ALL {
         let draw = |clouds: &mut CloudRenderer, wall_m| {
-            clouds_over_depth(&ctx, clouds, convention, wall_m, technique)
+            clouds_over_depth(&ctx, clouds, convention, wall_m, (technique, Reuse::None))
         };
         let (radiance, transmittance) = draw(&mut clouds, Some(500.0));
         assert_eq!(radiance, 0.0, "{technique:?} {convention:?}");
@@ -129,7 +129,7 @@ fn statistics_come_back_without_waiting() {
         &ctx,
         &mut clouds,
         DepthConvention::Standard,
-        Technique::Raymarch,
+        (Technique::Raymarch, Reuse::None),
     );
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let depth = depth_buffer(&ctx, &mut encoder, frame.size, 1.0);
@@ -148,6 +148,33 @@ fn statistics_come_back_without_waiting() {
     assert_eq!(late.pixels, frame.size.x * frame.size.y);
     assert!(late.density_samples_per_pixel > 1.0);
     assert!(early.is_none_or(|s| s == late));
+}
+
+/// A render scale of 1/2 ([`Reuse::Scaled`]): a quarter of the rays, upsampled to every pixel
+/// close to the full march, and geometry in front of the layer still hides the clouds.
+#[test]
+fn a_scaled_frame_marches_a_quarter_of_the_rays_and_fills_every_pixel() {
+    let ctx = GpuContext::for_tests();
+    let mut clouds = renderer(&ctx, Technique::Raymarch);
+    let convention = DepthConvention::Standard;
+    let mut draw = |reuse, wall_m| {
+        let drawn = (Technique::Raymarch, reuse);
+        let image = clouds_over_depth(&ctx, &mut clouds, convention, wall_m, drawn);
+        ctx.wait_idle();
+        let rays = clouds.stats(&ctx).expect("the frame's counters").pixels;
+        (image, rays)
+    };
+    let ((full_radiance, full_t), full_rays) = draw(Reuse::None, None);
+    let ((radiance, t), rays) = draw(Reuse::Scaled(2), None);
+    assert_eq!(4 * rays, full_rays, "rays marched at a render scale of 1/2");
+    let relative = (radiance - full_radiance).abs() / full_radiance;
+    assert!(
+        relative < 0.1 && (t - full_t).abs() < 0.05,
+        "the upsampled clouds differ from the full march: radiance {radiance} against \
+         {full_radiance} ({relative:.3}), mean transmittance {t} against {full_t}"
+    );
+    let ((hidden_radiance, hidden_t), _) = draw(Reuse::Scaled(2), Some(500.0));
+    assert_eq!((hidden_radiance, hidden_t), (0.0, 1.0), "geometry in front");
 }
 
 /// A colour target the compositor may read (never shown: the depth holds no geometry).

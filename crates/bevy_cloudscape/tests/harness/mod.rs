@@ -46,6 +46,8 @@ pub enum Step {
     Write(PathBuf, String),
     /// Wait until the sky asset has been reloaded.
     AwaitSkyReload,
+    /// Set the cameras' `Clouds::render_scale`.
+    RenderScale(f32),
 }
 
 /// Runs the flight world under the sky file `sky` (a name in `asset_dir`) through `script` in a
@@ -180,6 +182,7 @@ fn run_script(
         }
         Step::Write(path, text) => std::fs::write(&path, text).expect("write the scene file"),
         Step::AwaitSkyReload => script.waiting_for_reload = true,
+        Step::RenderScale(scale) => clouds.iter_mut().for_each(|mut c| c.render_scale = scale),
     }
 }
 

@@ -70,6 +70,21 @@ pub struct CloudShadowUniform {
     pad: [u32; 2],
 }
 
+/// The frame's map as a host binds it in its own shaders ([`crate::shadow::SHADOW_MAP_WGSL`]):
+/// [`crate::renderer::CloudRenderer::shadow_map`].
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowMapBinding<'a> {
+    /// The map: a 2-D array of two layers (the columns along the sun, then straight up), each
+    /// texel's four checkpoints' optical depths in rgba, in
+    /// [`EnvironmentGpu`]'s table format. Filled by the frame's environment
+    /// passes: copy or bind it after them.
+    pub texture: &'a wgpu::Texture,
+    /// Where the map lies: `CloudShadow` of `shadow_map.wgsl`.
+    pub params: CloudShadowUniform,
+    /// Unit vector toward the frame's sun, world space (`sun_direction` of the read).
+    pub sun_direction: Vec3,
+}
+
 impl CloudShadowUniform {
     /// The uniform of `params`.
     pub fn new(params: &ShadowParams) -> CloudShadowUniform {

@@ -31,7 +31,7 @@ mod table_pass;
 pub use atmosphere_passes::{ATMOSPHERE_AERIAL_WGSL, ATMOSPHERE_LUTS_WGSL, ATMOSPHERE_MARCH_WGSL};
 pub use gpu::{
     AirUniform, CloudShadowUniform, ENVIRONMENT_WGSL, EnvironmentGpu, EnvironmentTable,
-    EnvironmentUniform, LightVolumeUniform, TABLE_FORMAT, TableSizes,
+    EnvironmentUniform, LightVolumeUniform, ShadowMapBinding, TABLE_FORMAT, TableSizes,
 };
 pub use passes::{EnvironmentPasses, FrameLightVolume};
 pub use shadow_pass::CLOUD_SHADOW_WGSL;

@@ -15,7 +15,7 @@ use crate::environment::light_volume::{
 };
 use crate::environment::{
     CloudShadowUniform, Environment, EnvironmentGpu, EnvironmentPasses, EnvironmentTable,
-    EnvironmentUniform, LightVolumeUniform, Sky, TableSizes,
+    EnvironmentUniform, LightVolumeUniform, ShadowMapBinding, Sky, TableSizes,
 };
 pub use crate::field::gpu::FieldUpdate;
 
@@ -29,17 +29,21 @@ use crate::pass::Shared;
 use crate::post::upsample::Upsampler;
 use crate::post::{Background, Compositor, DISPLAY_FORMAT, Display, HDR_FORMAT};
 use crate::scene::Scene;
-use crate::shadow::{BuiltShadow, LightingReuse, ShadowMapBinding, ShadowParams};
+use crate::shadow::{BuiltShadow, LightingReuse, ShadowParams};
 use crate::technique::{FrameInputs, Technique, TechniqueStats, TechniqueTargets};
 use crate::temporal::{TemporalResolve, TemporalSettings};
 use glam::{UVec2, Vec2};
 use std::path::{Path, PathBuf};
 
-/// Whether a frame reuses earlier frames.
+/// Whether a frame reuses earlier frames, and how many rays it marches.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Reuse {
-    /// Every pixel rendered afresh.
+    /// Every pixel rendered afresh (at the technique's own resolution, e.g. the particles' half).
     None,
+    /// Every pixel rendered afresh from one ray per `n` x `n` pixels, depth-aware upsampled to the
+    /// frame's size (`post::upsample`, Yusov 2014): a render scale of `1 / n` (at most the
+    /// technique's own).
+    Scaled(u32),
     /// A coarse grid per frame plus reprojected history.
     Temporal(TemporalSettings),
 }
@@ -349,7 +353,11 @@ impl CloudRenderer {
         let grid = match (reuse, &self.temporal) {
             (Reuse::Temporal(_), Some(t)) => t.grid(frame.frame_index),
             _ => {
-                let divisor = self.technique.still_divisor();
+                let scaled = match reuse {
+                    Reuse::Scaled(n) => n.max(1),
+                    _ => 1,
+                };
+                let divisor = self.technique.still_divisor().max(scaled);
                 SampleGrid {
                     divisor,
                     subpixel: UVec2::splat((divisor - 1) / 2),

@@ -12,9 +12,8 @@
 //! by reading the column through it: `environment_cloud_sun_optical_depth(p)` in
 //! `environment.wgsl`, which [`CloudShadowMap::optical_depth`] specifies, through
 //! [`SHADOW_MAP_WGSL`]'s functions, which a host's own shaders import to read the map bound in
-//! their own group ([`ShadowMapBinding`]).
+//! their own group.
 
-use crate::environment::CloudShadowUniform;
 use crate::field::CloudField;
 use crate::scene::{PlanetShape, Scene};
 use glam::{Vec2, Vec3};
@@ -302,23 +301,8 @@ impl CloudShadowMap {
 mod tests;
 
 /// Reading the map in WGSL (`shadow_map.wgsl`): the `CloudShadow` struct (where the map lies, as
-/// [`CloudShadowUniform`] lays it out) and `cloud_shadow_sun_optical_depth(s, map, sampler, sun,
+/// the environment's `CloudShadowUniform` lays it out) and `cloud_shadow_sun_optical_depth(s, map, sampler, sun,
 /// p)`, with the map, a filtering sampler and the sun as arguments, so that the environment and a
 /// host's shaders read the map by the same code wherever it is bound.
 pub static SHADOW_MAP_WGSL: crate::shader::WgslModule =
     crate::shader::wgsl_module!("shadow_map", "shadow_map.wgsl", []);
-
-/// The frame's map as a host binds it in its own shaders ([`SHADOW_MAP_WGSL`]):
-/// [`crate::renderer::CloudRenderer::shadow_map`].
-#[derive(Clone, Copy, Debug)]
-pub struct ShadowMapBinding<'a> {
-    /// The map: a 2-D array of two layers (the columns along the sun, then straight up), each
-    /// texel's four checkpoints' optical depths in rgba, in
-    /// [`crate::environment::EnvironmentGpu`]'s table format. Filled by the frame's environment
-    /// passes: copy or bind it after them.
-    pub texture: &'a wgpu::Texture,
-    /// Where the map lies: `CloudShadow` of `shadow_map.wgsl`.
-    pub params: CloudShadowUniform,
-    /// Unit vector toward the frame's sun, world space (`sun_direction` of the read).
-    pub sun_direction: Vec3,
-}
