@@ -109,6 +109,7 @@ fn extract_cloud_views(
 fn begin_cloud_frames(
     views: Query<(MainEntity, &CloudView, &ExtractedView, &ExtractedCamera)>,
     mut renderers: ResMut<CloudRenderers>,
+    mut copy: ResMut<ShadowMapCopy>,
     (adapter, device, queue): (Res<RenderAdapter>, Res<RenderDevice>, Res<RenderQueue>),
 ) {
     let renderers = &mut *renderers;
@@ -125,6 +126,9 @@ fn begin_cloud_frames(
         .map(|(main, .., camera)| (camera.order, main))
         .min()
         .map(|(_, main)| main);
+    if renderers.shadow_source.is_none() {
+        copy.clear(&queue);
+    }
     for (main, cloud_view, view, camera) in &views {
         seen.insert(main);
         let Some(size) = camera.physical_target_size.filter(|s| s.x > 0 && s.y > 0) else {

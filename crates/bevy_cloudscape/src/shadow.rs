@@ -22,6 +22,7 @@ use bevy::render::render_resource::{
 };
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::shader::{Shader, ShaderRef};
+use bytemuck::Zeroable;
 use cloudscape::environment::ShadowMapBinding;
 use cloudscape::shader::Program;
 use cloudscape::shadow::SHADOW_MAP_WGSL;
@@ -155,6 +156,8 @@ pub struct ShadowMapCopy {
     uniform: Buffer,
     sampler: Sampler,
     generation: ShadowMapGeneration,
+    /// Whether the uniform holds a camera's map (not the disabled one).
+    live: bool,
 }
 
 /// `CloudShadowSource` of the module: where the map lies and the sun.
@@ -187,6 +190,15 @@ impl ShadowMapCopy {
             uniform,
             sampler,
             generation,
+            live: false,
+        }
+    }
+
+    /// Makes the materials read no cloud (no camera draws clouds any more).
+    pub(crate) fn clear(&mut self, queue: &RenderQueue) {
+        if std::mem::take(&mut self.live) {
+            let source = SourceUniform::zeroed();
+            queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&source));
         }
     }
 
@@ -214,6 +226,7 @@ impl ShadowMapCopy {
             sun_direction: map.sun_direction.extend(0.0).to_array(),
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&source));
+        self.live = true;
     }
 }
 

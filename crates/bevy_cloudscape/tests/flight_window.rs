@@ -9,7 +9,7 @@
 mod golden;
 #[allow(
     dead_code,
-    reason = "the harness's file edits serve the hot-reload test"
+    reason = "the harness's file edits and clouds off serve the hot-reload test"
 )]
 mod harness;
 

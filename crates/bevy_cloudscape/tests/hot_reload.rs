@@ -1,6 +1,7 @@
 //! A scene file edited on disk while the app runs reaches the next frames: the flight world's
 //! balloon, in a clear sky, disappears once its sky file is rewritten as an overcast deck, and the
-//! deck's shadow falls on the towers' `CloudShadowedMaterial`.
+//! deck's shadow falls on the towers' `CloudShadowedMaterial`, and leaves it when the camera's clouds are
+//! turned off.
 
 #[allow(
     dead_code,
@@ -32,6 +33,9 @@ fn an_edited_scene_file_reaches_the_next_frames() {
         Step::AwaitSkyReload,
         Step::Frames(3),
         Step::Screenshot,
+        Step::CloudsOff,
+        Step::Frames(3),
+        Step::Screenshot,
     ];
     let Some(shots) = harness::run(&dir, "sky.toml", script) else {
         return;
@@ -41,7 +45,8 @@ fn an_edited_scene_file_reaches_the_next_frames() {
     // pales it: measured 1.64), hidden by the deck (the deck's grey: 1.0-1.1).
     let balloon = |i: usize| redness(color_around(&shots[i], world::BALLOON, 0.015));
     let (before, after) = (balloon(0), balloon(1));
-    let (clear_face, overcast_face) = (sunlit_face(&shots[0]), sunlit_face(&shots[1]));
+    let faces = [0, 1, 2].map(|i| sunlit_face(&shots[i]));
+    let [clear_face, overcast_face, cloudless_face] = faces;
     eprintln!("the balloon's red over green and blue: {before:.2} clear, {after:.2} overcast");
     assert!(
         before > 1.4,
@@ -64,6 +69,13 @@ fn an_edited_scene_file_reaches_the_next_frames() {
         "under the overcast deck the tower's sunlit face is {overcast_face:.3}, {:.2} of its \
          {clear_face:.3} under the clear sky: the clouds cast no shadow on the material",
         overcast_face / clear_face
+    );
+    // With the camera's clouds off, nothing shadows the materials any more.
+    eprintln!("the tower's sunlit face with the clouds off: {cloudless_face:.3}");
+    assert!(
+        cloudless_face > 0.8 * clear_face,
+        "with the clouds turned off the tower's sunlit face stays dark ({cloudless_face:.3}, \
+         {clear_face:.3} under the clear sky): the materials still read the last shadow"
     );
 }
 

@@ -48,6 +48,8 @@ pub enum Step {
     AwaitSkyReload,
     /// Set the cameras' `Clouds::render_scale`.
     RenderScale(f32),
+    /// Turn the cameras' clouds off.
+    CloudsOff,
 }
 
 /// Runs the flight world under the sky file `sky` (a name in `asset_dir`) through `script` in a
@@ -183,6 +185,7 @@ fn run_script(
         Step::Write(path, text) => std::fs::write(&path, text).expect("write the scene file"),
         Step::AwaitSkyReload => script.waiting_for_reload = true,
         Step::RenderScale(scale) => clouds.iter_mut().for_each(|mut c| c.render_scale = scale),
+        Step::CloudsOff => clouds.iter_mut().for_each(|mut c| c.enabled = false),
     }
 }
 
