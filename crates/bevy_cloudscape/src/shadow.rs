@@ -147,8 +147,8 @@ pub(crate) fn warn_unshadowed_sun(
     }
 }
 
-/// The render world's copy of the shadow map that materials bind, with its uniform ([`CloudShadow`]'s
-/// binding parameter).
+/// The render world's copy of the shadow map that materials bind, with its uniform
+/// ([`CloudShadow`]'s binding parameter).
 #[derive(Resource)]
 pub struct ShadowMapCopy {
     texture: Texture,

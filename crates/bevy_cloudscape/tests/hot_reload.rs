@@ -1,7 +1,7 @@
 //! A scene file edited on disk while the app runs reaches the next frames: the flight world's
-//! balloon, in a clear sky, disappears once its sky file is rewritten as an overcast deck, and the
-//! deck's shadow falls on the towers' `CloudShadowedMaterial`, and leaves it when the camera's clouds are
-//! turned off.
+//! balloon, in a clear sky, disappears once its sky file is rewritten as an overcast deck; the
+//! deck's shadow falls on the towers' `CloudShadowedMaterial`, and leaves it when the camera's
+//! clouds are turned off.
 
 #[allow(
     dead_code,

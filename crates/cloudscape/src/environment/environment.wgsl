@@ -230,7 +230,8 @@ fn environment_shadow_offset(s: f32) -> f32 {
 // Cloud optical depth above height y at ground-plane point g, from `layer` of the environment's
 // shadow map (cloud_shadow_read).
 fn environment_shadow_read(g: vec2<f32>, y: f32, layer: i32) -> f32 {
-    return cloud_shadow_read(environment.shadow, environment_cloud_shadow, environment_linear, g, y, layer);
+    let s = environment.shadow;
+    return cloud_shadow_read(s, environment_cloud_shadow, environment_linear, g, y, layer);
 }
 
 // Optical depth of the clouds between world point p and the sun, from the shared light-space map

@@ -75,9 +75,8 @@ pub struct CloudShadowUniform {
 #[derive(Clone, Copy, Debug)]
 pub struct ShadowMapBinding<'a> {
     /// The map: a 2-D array of two layers (the columns along the sun, then straight up), each
-    /// texel's four checkpoints' optical depths in rgba, in
-    /// [`EnvironmentGpu`]'s table format. Filled by the frame's environment
-    /// passes: copy or bind it after them.
+    /// texel's four checkpoints' optical depths in rgba, in [`EnvironmentGpu`]'s table format.
+    /// Filled by the frame's environment passes: copy or bind it after them.
     pub texture: &'a wgpu::Texture,
     /// Where the map lies: `CloudShadow` of `shadow_map.wgsl`.
     pub params: CloudShadowUniform,

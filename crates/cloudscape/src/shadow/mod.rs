@@ -301,8 +301,9 @@ impl CloudShadowMap {
 mod tests;
 
 /// Reading the map in WGSL (`shadow_map.wgsl`): the `CloudShadow` struct (where the map lies, as
-/// the environment's `CloudShadowUniform` lays it out) and `cloud_shadow_sun_optical_depth(s, map, sampler, sun,
-/// p)`, with the map, a filtering sampler and the sun as arguments, so that the environment and a
-/// host's shaders read the map by the same code wherever it is bound.
+/// the environment's `CloudShadowUniform` lays it out) and
+/// `cloud_shadow_sun_optical_depth(s, map, sampler, sun, p)`, with the map, a filtering sampler and
+/// the sun as arguments, so that the environment and a host's shaders read the map by the same code
+/// wherever it is bound.
 pub static SHADOW_MAP_WGSL: crate::shader::WgslModule =
     crate::shader::wgsl_module!("shadow_map", "shadow_map.wgsl", []);
