@@ -207,21 +207,8 @@ fn start_up_without_xdg_runtime_dir_prints_no_wayland_noise() {
 #[test]
 fn a_short_soak_keeps_its_memory_and_reports_it() {
     let scratch = Scratch::new("soak");
-    let args = [
-        "bench",
-        "--soak",
-        "35",
-        "--soak-edit-every",
-        "5",
-        "--warmup",
-        "2",
-        "--width",
-        "48",
-        "--height",
-        "27",
-        "--set",
-        "render.quality=low",
-    ];
+    let soak = ["--soak", "35", "--soak-edit-every", "5", "--warmup", "2"];
+    let args = args(&["bench"], &[&soak, &TINY]);
     let run = cloudscape(scratch.path(), &args, true);
     assert!(run.success, "{}\n{}", run.stdout, run.stderr);
     for figure in ["resident memory", "live wgpu objects", "14 live edits"] {
