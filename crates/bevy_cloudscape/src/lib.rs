@@ -1,5 +1,6 @@
 #![doc = include_str!("../README.md")]
 
+mod ambient;
 mod render;
 mod shadow;
 mod sky;
@@ -17,9 +18,9 @@ use bevy::asset::io::file::FileAssetReader;
 use bevy::asset::{AssetApp, AssetPlugin, Assets};
 use bevy::camera::Camera3d;
 use bevy::ecs::schedule::IntoScheduleConfigs;
-use bevy::pbr::{MaterialPlugin, PbrPlugin};
-use bevy::render::RenderApp;
+use bevy::pbr::{MaterialPlugin, PbrPlugin, prepare_lights};
 use bevy::render::renderer::RenderDevice;
+use bevy::render::{Render, RenderApp, RenderSystems};
 use bevy::shader::Shader;
 
 /// Clouds over every `Camera3d`: add it to the `App` and each 3-D camera draws the clouds of its
@@ -44,6 +45,7 @@ impl Plugin for CloudscapePlugin {
             );
         add_cloud_shadow(app);
         render::build(app);
+        add_sky_ambient(app);
     }
 
     fn finish(&self, app: &mut App) {
@@ -56,6 +58,22 @@ impl Plugin for CloudscapePlugin {
             let copy = shadow::ShadowMapCopy::new(device, generation);
             render_app.insert_resource(copy);
         }
+    }
+}
+
+/// The sky's light on Bevy's materials (with Bevy's PBR): each view's ambient light, set before
+/// Bevy prepares its lights.
+fn add_sky_ambient(app: &mut App) {
+    if !app.is_plugin_added::<PbrPlugin>() {
+        return;
+    }
+    if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
+        render_app.add_systems(
+            Render,
+            ambient::light_materials_with_the_sky
+                .in_set(RenderSystems::CreateViews)
+                .before(prepare_lights),
+        );
     }
 }
 

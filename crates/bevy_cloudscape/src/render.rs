@@ -18,6 +18,7 @@ use bevy::render::renderer::{RenderAdapter, RenderContext, RenderDevice, RenderQ
 use bevy::render::sync_world::{MainEntity, RenderEntity};
 use bevy::render::view::{ExtractedView, ViewDepthStencilTexture, ViewTarget};
 use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderSystems};
+use cloudscape::field::CloudField;
 use cloudscape::frame::{DepthConvention, Frame};
 use cloudscape::gpu::GpuContext;
 use cloudscape::post::Background;
@@ -75,13 +76,21 @@ struct ViewClouds {
 
 /// Every camera's clouds, on Bevy's device.
 #[derive(Resource, Default)]
-struct CloudRenderers {
+pub(crate) struct CloudRenderers {
     gpu: Option<GpuContext>,
     /// Keyed by the camera's main-world entity.
     views: HashMap<Entity, ViewClouds>,
     /// The camera whose shadow map materials read: the lowest `Camera::order` among those with
     /// clouds (then the lowest entity).
     shadow_source: Option<Entity>,
+}
+
+impl CloudRenderers {
+    /// The cloud field (the CPU specification) of the camera with main-world entity `camera`,
+    /// once its renderer is built.
+    pub(crate) fn field(&self, camera: Entity) -> Option<&CloudField> {
+        self.views.get(&camera).map(|v| v.renderer.field())
+    }
 }
 
 /// A camera's render entity and its clouds, if any.

@@ -1,12 +1,13 @@
 //! The main world's side: the [`Clouds`] settings on a camera, what such a camera needs from Bevy,
 //! and each frame's inputs (the sky, the sun, the clock) gathered for the render world.
 
+use crate::ambient::AmbientOwner;
 use crate::sky::CloudSky;
 use bevy::asset::{Assets, Handle};
 use bevy::camera::{Camera3d, CameraMainTextureUsages, Exposure, Hdr};
 use bevy::color::{ColorToComponents, LinearRgba};
 use bevy::ecs::prelude::*;
-use bevy::light::{Atmosphere, DirectionalLight};
+use bevy::light::{AmbientLight, Atmosphere, DirectionalLight};
 use bevy::log::{error, warn};
 use bevy::platform::collections::HashSet;
 use bevy::render::render_resource::TextureUsages;
@@ -44,6 +45,12 @@ pub struct Clouds {
     /// shadow map kept until the eye and the wind have moved half of its finest texel, the light
     /// volume warm-started); false rebuilds both every frame.
     pub reuse_lighting: bool,
+    /// Light Bevy's materials with the sky: the camera's ambient light (set in the render world
+    /// each frame) is the mean radiance of the diffuse light over it, cloudscape's sky thinned by
+    /// the clouds straight above with the sunlight they scatter down. A camera with an
+    /// `AmbientLight` of its own keeps it; false leaves the camera to Bevy's
+    /// `GlobalAmbientLight`.
+    pub sky_ambient: bool,
 }
 
 impl Default for Clouds {
@@ -56,6 +63,7 @@ impl Default for Clouds {
             temporal_grid: Some(4),
             render_scale: 1.0,
             reuse_lighting: true,
+            sky_ambient: true,
         }
     }
 }
@@ -99,6 +107,8 @@ pub(crate) struct CloudView {
     pub sun: FrameSun,
     /// Bevy's virtual time, seconds.
     pub time_s: f32,
+    /// Whose ambient light the camera has.
+    pub ambient: AmbientOwner,
 }
 
 /// What [`configure_cameras`] reads and sets on a camera.
@@ -164,6 +174,7 @@ type CameraSky = (
     Option<&'static Exposure>,
     Option<&'static CloudView>,
     Has<Atmosphere>,
+    Has<AmbientLight>,
 );
 
 /// Gathers each camera's [`CloudView`] for the frame: its sky with the camera's overrides, the
@@ -176,7 +187,7 @@ pub(crate) fn update_cloud_views(
     (skies, default_sky, time): (Res<Assets<CloudSky>>, Res<DefaultSky>, Res<Time>),
     mut refused: Local<HashSet<Entity>>,
 ) {
-    for (entity, clouds, exposure, previous, atmosphere) in &cameras {
+    for (entity, clouds, exposure, previous, atmosphere, own_ambient) in &cameras {
         if atmosphere && clouds.enabled && refused.insert(entity) {
             refuse_second_sky(entity);
         }
@@ -203,6 +214,11 @@ pub(crate) fn update_cloud_views(
             reuse_lighting: clouds.reuse_lighting,
             sun,
             time_s: time.elapsed_secs(),
+            ambient: match (own_ambient, clouds.sky_ambient) {
+                (true, _) => AmbientOwner::Camera,
+                (false, true) => AmbientOwner::Sky,
+                (false, false) => AmbientOwner::Global,
+            },
         });
     }
 }

@@ -257,6 +257,52 @@ impl Environment {
     pub fn from_scene(scene: &Scene) -> Environment {
         Environment::new(&Sky::from_scene(scene), &FrameSun::from_scene(&scene.sun))
     }
+
+    /// Mean radiance of the diffuse light over the upper hemisphere at world point `p` under
+    /// `tau_above` of cloud straight up, for droplets of mean scattering cosine `asymmetry`: the
+    /// ambient light of a host's surfaces (no viewpoint's tables needed). Without clouds it is
+    /// the sky's (`environment_sky_mean_radiance_up`). Under them the light entering their top,
+    /// the sky's `E_sky` and the sun's `E_sun mu0` (through the air), leaves their base diffuse,
+    /// thinned by the transmission of a conservative slab lit by diffuse light,
+    /// `T = 1 / (1 + 3/4 (1 - g) tau)` (the two-stream result: Bohren 1987, "Multiple scattering
+    /// of light and some of its observable consequences", Am. J. Phys. 55), the sun's part less
+    /// what still arrives as the direct beam `exp(-tau / mu0)`:
+    /// `L = T E_sky / pi + max(T - exp(-tau / mu0), 0) E_sun mu0 / pi`. The clouds are taken as
+    /// a horizontal slab over `p`, as thick as the column above it. With the atmosphere it
+    /// builds or reuses the atmosphere's CPU tables ([`crate::atmosphere`]'s `Atmosphere::shared`:
+    /// about a second the first time in a debug build, then a look-up).
+    pub fn diffuse_radiance_up(&self, p: Vec3, tau_above: f32, asymmetry: f32) -> Vec3 {
+        let atmosphere =
+            (self.sky_model == SkyModel::Atmosphere).then(|| Atmosphere::shared(&self.air));
+        let atmosphere = atmosphere.as_deref();
+        let sky = self.sky_hemisphere(atmosphere, p, 1);
+        let tau = tau_above.max(0.0);
+        if tau == 0.0 {
+            return sky;
+        }
+        let through = 1.0 / (1.0 + 0.75 * (1.0 - asymmetry) * tau);
+        let mu0 = self.sun.direction.y.max(0.0);
+        let direct = if mu0 > 0.0 { (-tau / mu0).exp() } else { 0.0 };
+        let sun = self.sun.irradiance * self.air_transmittance(atmosphere, p) * mu0;
+        through * sky + (through - direct).max(0.0) * sun / PI
+    }
+
+    /// Transmittance of the air from `p` toward the sun, from `atmosphere`'s tables (1 without
+    /// them: the analytic skies).
+    fn air_transmittance(&self, atmosphere: Option<&Atmosphere>, p: Vec3) -> Vec3 {
+        atmosphere.map_or(Vec3::ONE, |a| a.sun_transmittance(p, self.sun.direction))
+    }
+
+    /// The sky over an upward surface at `p`: its irradiance (`layer` 0) or its mean radiance
+    /// (`layer` 1), from `atmosphere`'s tables (built for this air) or, without them, the
+    /// analytic sky's.
+    fn sky_hemisphere(&self, atmosphere: Option<&Atmosphere>, p: Vec3, layer: usize) -> Vec3 {
+        match (atmosphere, layer) {
+            (Some(a), _) => self.sun.irradiance * a.sky_irradiance(p, self.sun.direction, layer),
+            (None, 0) => self.sky.irradiance_up(),
+            (None, _) => self.sky.mean_radiance_up(),
+        }
+    }
 }
 
 /// The environment seen from one viewpoint: the CPU twin of every function of `environment.wgsl`
@@ -290,10 +336,7 @@ impl ViewedEnvironment {
     /// Transmittance of the air from `p` toward the sun (1 for the analytic skies):
     /// `environment_sun_transmittance`.
     pub fn sun_transmittance(&self, p: Vec3) -> Vec3 {
-        match &self.atmosphere {
-            Some((atmosphere, _)) => atmosphere.sun_transmittance(p, self.env.sun.direction),
-            None => Vec3::ONE,
-        }
+        self.env.air_transmittance(self.tables(), p)
     }
 
     /// Sun irradiance reaching `p` on a surface facing the sun: `environment_sun_irradiance`.
@@ -330,20 +373,21 @@ impl ViewedEnvironment {
 
     /// Mean sky radiance over the upper hemisphere at `p`: `environment_sky_mean_radiance_up`.
     pub fn sky_mean_radiance_up(&self, p: Vec3) -> Vec3 {
-        self.irradiance_table(p, 1)
-            .unwrap_or_else(|| self.env.sky.mean_radiance_up())
+        self.sky_hemisphere(p, 1)
     }
 
     /// Sky irradiance on an upward-facing surface at `p`: `environment_sky_irradiance_up`.
     pub fn sky_irradiance_up(&self, p: Vec3) -> Vec3 {
-        self.irradiance_table(p, 0)
-            .unwrap_or_else(|| self.env.sky.irradiance_up())
+        self.sky_hemisphere(p, 0)
     }
 
-    fn irradiance_table(&self, p: Vec3, layer: usize) -> Option<Vec3> {
-        let (atmosphere, _) = self.atmosphere.as_ref()?;
-        let sun = &self.env.sun;
-        Some(sun.irradiance * atmosphere.sky_irradiance(p, sun.direction, layer))
+    fn sky_hemisphere(&self, p: Vec3, layer: usize) -> Vec3 {
+        self.env.sky_hemisphere(self.tables(), p, layer)
+    }
+
+    /// The atmosphere's tables, with that model.
+    fn tables(&self) -> Option<&Atmosphere> {
+        self.atmosphere.as_ref().map(|(a, _)| &**a)
     }
 
     /// Radiance leaving a Lambertian ground of `albedo` at `p` under the unshadowed sun and sky:
@@ -404,6 +448,39 @@ mod tests {
         }
         assert!(mean.abs_diff_eq(sky.mean_radiance_up(), 1e-3));
         assert!(irr.abs_diff_eq(sky.irradiance_up(), 1e-3));
+    }
+
+    #[test]
+    fn diffuse_light_under_clouds_is_the_sky_without_them_and_thins_through_a_deck() {
+        let env = Environment::from_scene(&Scene::default());
+        let (p, g) = (Vec3::new(0.0, 2.0, 0.0), 0.85);
+        let clear = env.diffuse_radiance_up(p, 0.0, g);
+        let viewed = ViewedEnvironment::new(&env, p).sky_mean_radiance_up(p);
+        assert!(
+            clear.abs_diff_eq(viewed, 1e-6 * viewed.max_element()),
+            "{clear} {viewed}"
+        );
+        // Continuous at no cloud: a vanishing veil scatters a vanishing part of the sun.
+        let thin = env.diffuse_radiance_up(p, 1e-5, g);
+        assert!((thin - clear).abs().max_element() < 1e-3 * clear.max_element());
+        // A thick deck: everything that enters its top leaves its base diffuse, thinned by T.
+        let tau = 100.0;
+        let through = 1.0 / (1.0 + 0.75 * (1.0 - g) * tau);
+        let mu0 = env.sun.direction.y;
+        let atmosphere = Atmosphere::shared(&env.air);
+        let sun = env.sun.irradiance * atmosphere.sun_transmittance(p, env.sun.direction) * mu0;
+        let expected = through * (clear + sun / PI);
+        let deck = env.diffuse_radiance_up(p, tau, g);
+        assert!((deck - expected).abs().max_element() < 1e-3 * expected.max_element());
+        // Thicker decks let less through, and a thin veil adds the sunlight it scatters.
+        let radiance = |tau| env.diffuse_radiance_up(p, tau, g).y;
+        assert!(radiance(1000.0) < radiance(100.0) && radiance(100.0) < radiance(10.0));
+        assert!(
+            radiance(0.5) > clear.y,
+            "{} against {}",
+            radiance(0.5),
+            clear.y
+        );
     }
 
     #[test]

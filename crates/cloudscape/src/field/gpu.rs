@@ -491,7 +491,13 @@ struct NoiseGenParams {
 
 /// Runs `noise_gen.wgsl` into a storage buffer and copies it into a texture (a path that works on
 /// every backend, GL included, unlike 3D storage-texture writes).
+/// Made once per device and seed ([`GpuContext::shared_texture`]).
 fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture {
+    let key = (kind.texture_name(), u64::from(seed));
+    ctx.shared_texture(key, || make_noise(ctx, kind, seed))
+}
+
+fn make_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture {
     let device = &ctx.device;
     let dims = kind.dims();
     let row_pitch = (dims.x * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) / 4;
@@ -525,7 +531,6 @@ fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture
             ("noise_texels", buffer.as_entire_binding()),
         ],
     );
-    let label = format!("{kind:?} noise");
     let dimension = if kind == NoiseKind::Curl {
         wgpu::TextureDimension::D2
     } else {
@@ -533,7 +538,7 @@ fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture
     };
     let texture = create_texture(
         ctx,
-        &label,
+        kind.texture_name(),
         dims,
         wgpu::TextureFormat::Rgba8Unorm,
         dimension,

@@ -298,6 +298,33 @@ impl CloudField {
         tau
     }
 
+    /// Lowest and highest world heights of the clouds at the origin, and whether there are any.
+    pub(crate) fn cloud_heights(&self) -> (f32, f32, bool) {
+        let layers = self.altitude_range_m();
+        let volumes = self
+            .volumes
+            .iter()
+            .map(|v| (v.min_m.y, v.min_m.y + v.size_m.y))
+            .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
+        match (layers, volumes) {
+            (Some(l), Some(v)) => (l.0.min(v.0), l.1.max(v.1), true),
+            (Some(r), None) | (None, Some(r)) => (r.0, r.1, true),
+            (None, None) => (0.0, 1.0, false),
+        }
+    }
+
+    /// Optical depth of the coarse field straight up from `p` to the top of the clouds at scene
+    /// time `time_s` (0 above them): the clouds over a point, from 32 uniform segments.
+    pub fn coarse_optical_depth_above(&self, p: Vec3, time_s: f32) -> f32 {
+        let (bottom_m, top_m, any) = self.cloud_heights();
+        let start_m = (bottom_m - p.y).max(0.0);
+        let length_m = top_m - p.y - start_m;
+        if !any || length_m <= 0.0 {
+            return 0.0;
+        }
+        self.coarse_optical_depth((p, Vec3::Y), (start_m, length_m, 1.0), (32, 0.5), time_s)
+    }
+
     fn extinction(&self, p: Vec3, time_s: f32, detail: Detail) -> f32 {
         let h = self.planet.altitude_m(p);
         let layers: f32 = self

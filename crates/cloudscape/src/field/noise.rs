@@ -38,6 +38,15 @@ impl NoiseKind {
         }
     }
 
+    /// Name of its texture: its label, and its key among a device's shared textures.
+    pub fn texture_name(self) -> &'static str {
+        match self {
+            NoiseKind::Base => "base noise",
+            NoiseKind::Detail => "detail noise",
+            NoiseKind::Curl => "curl noise",
+        }
+    }
+
     /// Index of this kind in the GPU generator's `kind` switch (see `noise.wgsl`).
     pub fn gpu_index(self) -> u32 {
         self as u32

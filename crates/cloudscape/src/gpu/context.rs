@@ -7,6 +7,7 @@
 
 use std::fmt;
 use std::str::FromStr;
+use std::sync::{Arc, Mutex, PoisonError};
 
 /// What to install when no adapter exists; part of every [`GpuError::NoAdapter`] message.
 const INSTALL_HINT: &str = "On Debian/Ubuntu: apt-get install mesa-vulkan-drivers libvulkan1 \
@@ -124,7 +125,17 @@ pub struct GpuContext {
     info: wgpu::AdapterInfo,
     /// The instance the adapter came from; None for a host's own device.
     instance: Option<wgpu::Instance>,
+    /// Textures made once for the device ([`GpuContext::shared_texture`]).
+    shared_textures: Arc<Mutex<Vec<(SharedTextureKey, wgpu::Texture)>>>,
 }
+
+/// What names a texture [`GpuContext::shared_texture`] shares: what it holds and the number it
+/// was made from (a noise seed).
+pub type SharedTextureKey = (&'static str, u64);
+
+/// Textures [`GpuContext::shared_texture`] keeps: the last eight made (the noise of a field is
+/// three; a viewer that changes seeds keeps a few of them).
+const SHARED_TEXTURES_KEPT: usize = 8;
 
 impl GpuContext {
     /// Picks an adapter as described in the module documentation and opens a device on it.
@@ -215,6 +226,7 @@ impl GpuContext {
             adapter,
             info,
             instance: Some(instance),
+            shared_textures: Arc::default(),
         })
     }
 
@@ -234,7 +246,36 @@ impl GpuContext {
             adapter,
             info,
             instance: None,
+            shared_textures: Arc::default(),
         }
+    }
+
+    /// The texture `make` makes for `key`, made once for this device and shared by everything
+    /// on it that asks for the same key: for inputs that depend on nothing but their key (a
+    /// field's noise, from its kind and seed), so a second renderer on the device (another
+    /// camera, another technique, the next test) makes none. The caller must not write to it.
+    /// The last few keys are kept; on a software adapter the field's noise is seconds of work.
+    pub fn shared_texture(
+        &self,
+        key: SharedTextureKey,
+        make: impl FnOnce() -> wgpu::Texture,
+    ) -> wgpu::Texture {
+        let lock = || {
+            self.shared_textures
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+        };
+        if let Some((_, texture)) = lock().iter().find(|(k, _)| *k == key) {
+            return texture.clone();
+        }
+        let texture = make();
+        let mut kept = lock();
+        kept.retain(|(k, _)| *k != key);
+        if kept.len() >= SHARED_TEXTURES_KEPT {
+            kept.remove(0);
+        }
+        kept.push((key, texture.clone()));
+        texture
     }
 
     /// The chosen adapter (a window's surface asks it what it can present).

@@ -51,7 +51,7 @@ impl ShadowParams {
     pub fn new(scene: &Scene, field: &CloudField, viewpoint_m: Vec3, sun: Vec3) -> ShadowParams {
         let half_extent_m = scene.camera.far_m.max(1000.0);
         let sun_y = sun.y.max(SHADOW_MIN_SUN_Y);
-        let (bottom, top, enabled) = cloud_heights(field);
+        let (bottom, top, enabled) = field.cloud_heights();
         // On a sphere the clouds sink below y = 0 with distance d by about d^2 / 2R; the columns
         // reach past the map by the sun's slant over the clouds' top.
         let slant = top.max(0.0) * Vec2::new(sun.x, sun.z).length() / sun_y;
@@ -217,21 +217,6 @@ impl BuiltShadow {
         let eye_m = (fresh.params.centre_m - self.params.centre_m).length();
         let clouds_m = wind_m_per_s.length() * (fresh.time_s - self.time_s).abs();
         eye_m + clouds_m <= reuse.max_shadow_drift_texels * self.params.finest_texel_m(self.texels)
-    }
-}
-
-/// Lowest and highest world heights of the field's clouds at the origin, and whether it has any.
-pub(crate) fn cloud_heights(field: &CloudField) -> (f32, f32, bool) {
-    let layers = field.altitude_range_m();
-    let volumes = field
-        .volumes
-        .iter()
-        .map(|v| (v.min_m.y, v.min_m.y + v.size_m.y))
-        .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
-    match (layers, volumes) {
-        (Some(l), Some(v)) => (l.0.min(v.0), l.1.max(v.1), true),
-        (Some(r), None) | (None, Some(r)) => (r.0, r.1, true),
-        (None, None) => (0.0, 1.0, false),
     }
 }
 

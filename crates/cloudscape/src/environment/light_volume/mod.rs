@@ -149,7 +149,7 @@ pub struct LightVolumeGrid {
 impl LightVolumeGrid {
     /// The cascades of `settings` around `viewpoint_m`, through `field`'s heights.
     pub fn new(settings: &LightVolumeSettings, field: &CloudField, viewpoint_m: Vec3) -> Self {
-        let (bottom_m, top_m, enabled) = crate::shadow::cloud_heights(field);
+        let (bottom_m, top_m, enabled) = field.cloud_heights();
         let cells = settings.cells();
         let cascades = (0..settings.cascades)
             .map(|c| {
