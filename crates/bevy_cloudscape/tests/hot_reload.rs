@@ -1,7 +1,8 @@
 //! A scene file edited on disk while the app runs reaches the next frames: the flight world's
 //! balloon, in a clear sky, disappears once its sky file is rewritten as an overcast deck; the
-//! deck's shadow falls on the towers' `CloudShadowedMaterial`, and leaves it when the camera's
-//! clouds are turned off.
+//! deck's shadow falls on the towers' `CloudShadowedMaterial` (measured without the sky's ambient
+//! light, so only the sun's part changes), the sky's ambient light under the deck lights the face
+//! again, and the shadow leaves when the camera's clouds are turned off.
 
 #[allow(
     dead_code,
@@ -27,12 +28,17 @@ fn an_edited_scene_file_reaches_the_next_frames() {
     )
     .expect("the overcast sky");
     let script = vec![
+        Step::SkyAmbient(false),
         Step::Frames(30),
         Step::Screenshot,
         Step::Write(sky.clone(), overcast),
         Step::AwaitSkyReload,
         Step::Frames(3),
         Step::Screenshot,
+        Step::SkyAmbient(true),
+        Step::Frames(3),
+        Step::Screenshot,
+        Step::SkyAmbient(false),
         Step::CloudsOff,
         Step::Frames(3),
         Step::Screenshot,
@@ -45,8 +51,8 @@ fn an_edited_scene_file_reaches_the_next_frames() {
     // pales it: measured 1.64), hidden by the deck (the deck's grey: 1.0-1.1).
     let balloon = |i: usize| redness(color_around(&shots[i], world::BALLOON, 0.015));
     let (before, after) = (balloon(0), balloon(1));
-    let faces = [0, 1, 2].map(|i| sunlit_face(&shots[i]));
-    let [clear_face, overcast_face, cloudless_face] = faces;
+    let faces = [0, 1, 2, 3].map(|i| sunlit_face(&shots[i]));
+    let [clear_face, overcast_face, sky_lit_face, cloudless_face] = faces;
     eprintln!("the balloon's red over green and blue: {before:.2} clear, {after:.2} overcast");
     assert!(
         before > 1.4,
@@ -69,6 +75,14 @@ fn an_edited_scene_file_reaches_the_next_frames() {
         "under the overcast deck the tower's sunlit face is {overcast_face:.3}, {:.2} of its \
          {clear_face:.3} under the clear sky: the clouds cast no shadow on the material",
         overcast_face / clear_face
+    );
+    // The sky's light under the deck (an optical depth of about 15 overhead lets a third of the
+    // light through, diffuse) lights the face far more than Bevy's default ambient light.
+    eprintln!("the tower's face under the deck with the sky's ambient light: {sky_lit_face:.3}");
+    assert!(
+        sky_lit_face > 1.5 * overcast_face,
+        "under the deck the sky's ambient light leaves the tower's face at {sky_lit_face:.3}, \
+         {overcast_face:.3} without it: the camera's ambient light was not set"
     );
     // With the camera's clouds off, nothing shadows the materials any more.
     eprintln!("the tower's sunlit face with the clouds off: {cloudless_face:.3}");

@@ -50,6 +50,8 @@ pub enum Step {
     RenderScale(f32),
     /// Turn the cameras' clouds off.
     CloudsOff,
+    /// Set the cameras' `Clouds::sky_ambient`.
+    SkyAmbient(bool),
 }
 
 /// Runs the flight world under the sky file `sky` (a name in `asset_dir`) through `script` in a
@@ -186,6 +188,7 @@ fn run_script(
         Step::AwaitSkyReload => script.waiting_for_reload = true,
         Step::RenderScale(scale) => clouds.iter_mut().for_each(|mut c| c.render_scale = scale),
         Step::CloudsOff => clouds.iter_mut().for_each(|mut c| c.enabled = false),
+        Step::SkyAmbient(on) => clouds.iter_mut().for_each(|mut c| c.sky_ambient = on),
     }
 }
 
