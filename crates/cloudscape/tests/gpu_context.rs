@@ -329,3 +329,19 @@ fn run_sample_shader(ctx: &GpuContext, texture: &wgpu::Texture, points: &[[f32; 
     ctx.queue.submit([encoder.finish()]);
     gpu::read_buffer::<f32>(ctx, &sample_buffer)
 }
+
+#[test]
+fn a_shared_texture_is_made_once_per_key() {
+    let ctx = GpuContext::for_tests();
+    let made = std::cell::Cell::new(0);
+    let make = || {
+        made.set(made.get() + 1);
+        texture_with(&ctx, wgpu::TextureFormat::R8Unorm, [1, 1], &[7])
+    };
+    let first = ctx.shared_texture(("shared texture test", 1), make);
+    let again = ctx.shared_texture(("shared texture test", 1), make);
+    let other = ctx.shared_texture(("shared texture test", 2), make);
+    assert_eq!(made.get(), 2, "one texture per key");
+    assert!(first == again, "the same key gives the texture made before");
+    assert!(first != other, "another key gives another texture");
+}

@@ -489,14 +489,14 @@ struct NoiseGenParams {
     depth: u32,
 }
 
-/// Runs `noise_gen.wgsl` into a storage buffer and copies it into a texture (a path that works on
-/// every backend, GL included, unlike 3D storage-texture writes).
-/// Made once per device and seed ([`GpuContext::shared_texture`]).
+/// The noise texture of `kind` for `seed`, made once per device ([`GpuContext::shared_texture`]).
 fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture {
     let key = (kind.texture_name(), u64::from(seed));
     ctx.shared_texture(key, || make_noise(ctx, kind, seed))
 }
 
+/// Runs `noise_gen.wgsl` into a storage buffer and copies it into a texture (a path that works on
+/// every backend, GL included, unlike 3D storage-texture writes).
 fn make_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture {
     let device = &ctx.device;
     let dims = kind.dims();
