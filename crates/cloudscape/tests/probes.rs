@@ -655,6 +655,22 @@ fn phase_functions_and_height_profiles_match_the_cpu() {
             .map(|(mu, factor)| Vec4::splat(phase.scaled_anisotropy(*factor).eval(*mu)))
             .collect();
         assert_close(&format!("{phase:?}"), &got, &want, 1e-4);
+        let peak = phase.diffraction_peak_weight();
+        let inputs: Vec<ProbeInput> = cases
+            .iter()
+            .map(|(mu, _)| {
+                input(
+                    Vec4::from_array(phase.to_gpu()),
+                    Vec4::new(*mu, 1.0, peak, 0.0),
+                )
+            })
+            .collect();
+        let got = gpu(&ctx, &clouds, ProbeFunction::PhaseBroadShare, &inputs);
+        let want: Vec<Vec4> = cases
+            .iter()
+            .map(|(mu, _)| Vec4::splat(phase.broad_share(peak, *mu)))
+            .collect();
+        assert_close(&format!("broad share of {phase:?}"), &got, &want, 1e-4);
         let octaves = Octaves {
             count: 6,
             attenuation: 0.3,

@@ -7,7 +7,9 @@ pub(crate) mod phase;
 pub(crate) mod slab;
 pub(crate) mod step;
 
-pub use phase::{Lobe, Octaves, PhaseLobes, draine, henyey_greenstein};
+pub use phase::{
+    DIFFRACTION_PEAK_MIN_ASYMMETRY, Lobe, Octaves, PhaseLobes, draine, henyey_greenstein,
+};
 pub use slab::SunSlab;
 pub use step::MarchState;
 

@@ -21,6 +21,12 @@ pub const MIE_FIT_MIN_DIAMETER_UM: f32 = 5.0;
 /// Largest droplet diameter, in micrometres, of the approximate-Mie fit (Jendersie & d'Eon 2023).
 pub const MIE_FIT_MAX_DIAMETER_UM: f32 = 50.0;
 
+/// Least asymmetry of a Henyey-Greenstein lobe that [`PhaseLobes::diffraction_peak_weight`]
+/// counts as the droplets' diffraction peak: such a lobe scatters half its light by under 3
+/// degrees (`g = 0.9946`, 20 um droplets: 0.54 degrees), and Jendersie & d'Eon 2023's fit gives its
+/// HG lobe at least 0.9707 over the whole 5..50 um range, so every droplet size has a peak.
+pub const DIFFRACTION_PEAK_MIN_ASYMMETRY: f32 = 0.97;
+
 /// One of the two lobes of a [`PhaseLobes`] mixture.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Lobe {
@@ -95,6 +101,28 @@ impl PhaseLobes {
         let w = f64::from(self.w_draine);
         (1.0 - w) * hg_f64(f64::from(self.g_hg), mu)
             + w * draine_f64(f64::from(self.g_draine), f64::from(self.alpha), mu)
+    }
+
+    /// The share of the scattering that the diffraction peak holds: the Henyey-Greenstein lobe's
+    /// weight when the lobe is at least [`DIFFRACTION_PEAK_MIN_ASYMMETRY`] asymmetric, else 0 (a
+    /// plain or dual HG model of moderate asymmetry has no peak). Light scattered by the peak keeps
+    /// its direction to within a few pixels: the march treats it as not scattered on its way to
+    /// the eye (`raymarch.wgsl`, `march_segment`).
+    pub fn diffraction_peak_weight(&self) -> f32 {
+        if self.g_hg >= DIFFRACTION_PEAK_MIN_ASYMMETRY {
+            1.0 - self.w_draine
+        } else {
+            0.0
+        }
+    }
+
+    /// The share of `p(cos_theta)` outside a peak of weight `peak_weight` (0 or
+    /// [`Self::diffraction_peak_weight`]): `1 - w_p HG(g_hg, mu) / p(mu)`. The GPU twin is
+    /// `phase_broad_share`.
+    pub fn broad_share(&self, peak_weight: f32, cos_theta: f32) -> f32 {
+        let mu = f64::from(cos_theta);
+        let peak = f64::from(peak_weight) * hg_f64(f64::from(self.g_hg), mu);
+        (1.0 - peak / self.eval_f64(mu)).clamp(0.0, 1.0) as f32
     }
 
     /// The same lobes with both asymmetries multiplied by `factor`: octave `i` of the

@@ -30,6 +30,13 @@ fn phase_eval(lobes: vec4<f32>, cos_theta: f32) -> f32 {
     return (1.0 - lobes.w) * hg + lobes.w * draine;
 }
 
+// The share of phase_eval(lobes, cos_theta) outside a peak of weight peak_weight in the HG lobe
+// (PhaseLobes::broad_share).
+fn phase_broad_share(lobes: vec4<f32>, peak_weight: f32, cos_theta: f32) -> f32 {
+    let peak = peak_weight * phase_hg(lobes.x, cos_theta);
+    return clamp(1.0 - peak / phase_eval(lobes, cos_theta), 0.0, 1.0);
+}
+
 // Both asymmetries times factor (multiple-scattering octaves, Wrenninge 2013).
 fn phase_scaled(lobes: vec4<f32>, factor: f32) -> vec4<f32> {
     return vec4<f32>(lobes.xy * factor, lobes.zw);

@@ -183,6 +183,40 @@ fn scaled_anisotropy_scales_only_the_asymmetries() {
 }
 
 #[test]
+fn droplets_of_every_size_have_a_diffraction_peak_and_moderate_lobes_none() {
+    for d in [5.0, 10.0, 20.0, 50.0] {
+        let mie = PhaseLobes::approximate_mie(d);
+        assert_eq!(mie.diffraction_peak_weight(), 1.0 - mie.w_draine, "{d} um");
+        assert!(mie.diffraction_peak_weight() > 0.3, "{d} um");
+    }
+    assert_eq!(
+        PhaseLobes::henyey_greenstein(0.85).diffraction_peak_weight(),
+        0.0
+    );
+    let dual = PhaseLobes::dual_henyey_greenstein(0.8, -0.3, 0.9);
+    assert_eq!(dual.diffraction_peak_weight(), 0.0);
+}
+
+#[test]
+fn the_broad_share_leaves_out_the_peak_where_it_scatters() {
+    let mie = PhaseLobes::approximate_mie(20.0);
+    let peak = mie.diffraction_peak_weight();
+    // Toward the sun the peak is nearly all of p; beyond a few degrees nearly none of it.
+    assert!(mie.broad_share(peak, 1.0) < 0.01);
+    assert!(mie.broad_share(peak, 20f32.to_radians().cos()) > 0.95);
+    assert!(mie.broad_share(peak, -1.0) > 0.99);
+    // Weighted by p over the sphere, the broad share is the broad lobes' weight.
+    let broad = sphere_integral(|mu| {
+        let mu = mu as f32;
+        f64::from(mie.eval(mu) * mie.broad_share(peak, mu))
+    });
+    assert!((broad - f64::from(mie.w_draine)).abs() < 1e-3, "{broad}");
+    // Without a peak every direction is broad.
+    let hg = PhaseLobes::henyey_greenstein(0.85);
+    assert_eq!(hg.broad_share(0.0, 1.0), 1.0);
+}
+
+#[test]
 fn to_gpu_layout_is_g_hg_g_draine_alpha_w() {
     let lobes = PhaseLobes {
         g_hg: 0.9,

@@ -82,6 +82,8 @@ pub enum ProbeFunction {
     LightVolumeDiffuse = 28,
     /// `environment_light_volume_ground_irradiance(a.xyz)`: `LightVolume::ground_irradiance`.
     LightVolumeGroundIrradiance = 29,
+    /// `phase_broad_share(lobes a, peak weight b.z, cos theta b.x)`: `PhaseLobes::broad_share`.
+    PhaseBroadShare = 30,
 }
 
 /// The inputs of one evaluation.

@@ -63,6 +63,17 @@ impl MarchSettings {
         }
     }
 
+    /// The share of the scattering that keeps light on its way to the eye (the diffraction peak,
+    /// [`PhaseLobes::diffraction_peak_weight`]) with the light volume; 0 with the slab and the
+    /// octaves, kept as they were fitted and tuned: with the view ray dimmed by the whole
+    /// extinction.
+    pub fn view_peak_weight(&self) -> f32 {
+        match self.model {
+            LightingModel::Volume => self.phase.diffraction_peak_weight(),
+            LightingModel::Slab | LightingModel::Octaves => 0.0,
+        }
+    }
+
     /// Steps of a quality preset: (primary, light, samples per pixel).
     pub fn preset(quality: Quality) -> (u32, u32, u32) {
         match quality {
@@ -120,7 +131,7 @@ struct MarchUniform {
     lighting_model: u32,
     tile_origin: UVec2,
     back_steps: u32,
-    reserved: u32,
+    view_peak_weight: f32,
     slab_params: Vec4,
 }
 
@@ -145,6 +156,7 @@ impl MarchUniform {
                 LightingModel::Volume => LIGHTING_MODEL_VOLUME,
             },
             back_steps: settings.back_steps(),
+            view_peak_weight: settings.view_peak_weight(),
             slab_params: Vec4::from_array(settings.slab.params_to_gpu()),
             ..MarchUniform::zeroed()
         }
@@ -351,7 +363,7 @@ mod tests {
                 lighting_model,
                 tile_origin,
                 back_steps,
-                reserved,
+                view_peak_weight,
                 slab_params,
             }
         );

@@ -18,7 +18,7 @@ struct March {
     lighting_model: u32,        // 0: slab (optics/slab.rs), 1: octaves, 2: the light volume
     tile_origin: vec2<u32>,     // first texel of the band
     back_steps: u32,            // samples away from the sun from each view sample (slab)
-    reserved: u32,
+    view_peak_weight: f32,      // MarchSettings::view_peak_weight: scattering that keeps light on the ray
     slab_params: vec4<f32>,     // SunSlab::params_to_gpu
 }
 
@@ -155,13 +155,25 @@ fn march_first_stratum(t0: f32, t1: f32, n: u32, empty_until: f32) -> u32 {
 // Integrates [t0, t1] in `march_step_count` strata, one sample per stratum at fraction `jitter` of it,
 // with Hillaire 2016's energy-conserving step: S_int = (S - S exp(-sigma_t dt)) / sigma_t;
 // L += T S_int; T *= exp(-sigma_t dt).
+// The view ray's own forward scattering (δ-M, Wiscombe 1977, on the way to the eye): the droplets'
+// diffraction peak, a share w_p of their scattering (march.view_peak_weight), deflects light by
+// under a few pixels, so light it scatters stays on the ray. Light scattered toward the eye by the
+// rest of the phase function (the diffuse field by the broad lobe, 1 - w_p; the sun's beam by
+// its share outside the peak, phase_broad_share) reaches the eye through the δ-scaled transmittance
+// T' of sigma_t (1 - albedo w_p). The beam's light scattered by the peak itself runs along the
+// beam, whose own peak scatterings slab_beam_scattering already counts, so it keeps the whole
+// extinction T. T, the pixel's transmittance, dims the background. w_p = 0 gives the plain march.
 // Samples in the leading empty stretch (march_empty_until) are skipped: they would read zero.
 // `volume` is the stretch inside voxel-grid boxes.
 fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volume: vec2<f32>, reads_volume: bool) -> MarchResult {
     let n = march_step_count(t1 - t0);
     let albedo = march.albedo;
+    let peak = march.view_peak_weight;
+    let thinning = 1.0 - albedo * peak;
+    let broad_sun = phase_broad_share(march.phase_lobes, peak, dot(d, environment_sun_direction()));
     var radiance = vec3<f32>(0.0);
     var transmittance = 1.0;
+    var scaled_transmittance = 1.0;
     var distance_weighted = 0.0;
     var samples = 0u;
     let empty_until = march_empty_until(o, d, t0, t1, volume);
@@ -183,13 +195,16 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
             continue;
         }
         let tau_sun = march_sun_optical_depth(p, march.light_steps, jitter);
-        let sun = march_sun_scattering(p, d, tau_sun, jitter, reads_volume) * light.sun;
-        let source = albedo * (sun + march_diffuse(p, d, light, reads_volume));
+        let sun = albedo * march_sun_scattering(p, d, tau_sun, jitter, reads_volume) * light.sun;
+        let diffuse = albedo * (1.0 - peak) * march_diffuse(p, d, light, reads_volume);
         let step_transmittance = exp(-sigma_t * dt);
-        radiance += transmittance * source * (1.0 - step_transmittance);
+        let scaled_step = exp(-sigma_t * thinning * dt);
+        radiance += transmittance * (1.0 - broad_sun) * sun * (1.0 - step_transmittance);
+        radiance += scaled_transmittance * (broad_sun * sun + diffuse) * (1.0 - scaled_step) / thinning;
         distance_weighted += transmittance * (1.0 - step_transmittance) * distance(p, o);
         transmittance *= step_transmittance;
-        if transmittance < MARCH_MIN_TRANSMITTANCE {
+        scaled_transmittance *= scaled_step;
+        if scaled_transmittance < MARCH_MIN_TRANSMITTANCE {
             break;
         }
     }
