@@ -65,6 +65,10 @@ pub struct FrameInputs<'a> {
     /// The shared GPU groups as this frame set them (the field at the frame's time), for work
     /// whose result the CPU needs before encoding (reading the field at many points).
     pub shared: Shared<'a>,
+    /// Whether the host renders a stream of frames and carries work across them (it set
+    /// [`crate::shadow::LightingReuse`]): a technique may spread remaking what an edit changed
+    /// over frames, drawing what it had until it is replaced. A still (false) is complete.
+    pub real_time: bool,
 }
 
 /// Where a technique reads and writes.

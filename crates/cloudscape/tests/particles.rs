@@ -62,6 +62,7 @@ impl Harness {
             environment: self.clouds.environment(),
             grid: &SampleGrid::FULL,
             shared: self.clouds.shared(),
+            real_time: false,
         };
         self.particles.prepare(ctx, &inputs);
         let targets = TechniqueTargets {

@@ -407,6 +407,7 @@ impl CloudRenderer {
                 frame: &self.frame_gpu,
                 environment: &self.environment_gpu,
             },
+            real_time: self.lighting_reuse.is_some(),
         };
         let start = std::time::Instant::now();
         self.technique.prepare(ctx, &inputs);

@@ -171,7 +171,9 @@ impl ShadowParams {
 /// between builds the shadows lag the clouds by at most the drift allowed. The light volume's solve
 /// starts from the last frame's solution (the scene's `lighting.volume_warm_sweeps` sweeps a frame)
 /// and its grid is recentred only once the eye has moved
-/// [`crate::environment::light_volume::RECENTRE_CELLS`] cells.
+/// [`crate::environment::light_volume::RECENTRE_CELLS`] cells. The sprite technique remakes its
+/// clouds over frames after an edit of coverage, nearest the eye first
+/// ([`crate::technique::FrameInputs::real_time`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightingReuse {
     /// The map is rebuilt once its centre (under the eye) and the clouds (with the wind) have

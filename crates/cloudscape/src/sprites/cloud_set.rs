@@ -9,7 +9,8 @@ use std::path::Path;
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
 
-use super::from_field::{FieldTiling, TileDraft, TileKey};
+use super::field_tiles::{FieldTiles, TilesChanged};
+use super::from_field::{FieldTiling, TileKey};
 use super::model::SpriteCloud;
 use super::shading::{self, ColorLevel, LEVELS, SunLight, physical_levels};
 use super::{CloudModel, ModelFile};
@@ -80,17 +81,25 @@ impl GpuCloud {
 /// A cloud to lay out: the cloud, its colour levels (None: derived) and whether the field made it.
 type Laid<'a> = (&'a SpriteCloud, Option<[ColorLevel; LEVELS]>, bool);
 
+/// One cloud laid out for the GPU.
+struct LaidCloud {
+    cloud: GpuCloud,
+    sprites: Vec<GpuSprite>,
+    /// Its centre at time 0 (wind frame) and its layer ([`CloudSet::cloud_centres`]).
+    centre: (Vec3, u32),
+}
+
 /// The scene's sprite clouds and their GPU records.
 pub struct CloudSet {
     authored: Vec<Authored>,
-    tiling: Option<FieldTiling>,
-    /// Each tile's draft (its candidates), kept while the camera stays near and through edits
-    /// that change only the field's density (coverage).
-    drafts: BTreeMap<TileKey, Option<TileDraft>>,
-    /// Each tile's cloud at the field's current density.
-    tiles: BTreeMap<TileKey, Option<SpriteCloud>>,
+    /// The field's clouds, tile by tile (None when the scene makes none).
+    field_tiles: Option<FieldTiles>,
+    /// Each field tile's cloud laid out for the GPU, kept until the tile is remade or the light
+    /// changes, so that a frame that remakes a few tiles lays out only those.
+    laid: BTreeMap<TileKey, Option<LaidCloud>>,
     scene_key: String,
     draft_key: String,
+    layout_key: String,
     /// The light of the configured scene, toward the sun the groups were last lit by.
     light: SunLight,
     /// Extinction of clouds of no layer (hand-made), m^-1: the densest layer's.
@@ -113,11 +122,11 @@ impl Default for CloudSet {
     fn default() -> CloudSet {
         CloudSet {
             authored: Vec::new(),
-            tiling: None,
-            drafts: BTreeMap::new(),
-            tiles: BTreeMap::new(),
+            field_tiles: None,
+            laid: BTreeMap::new(),
             scene_key: String::new(),
             draft_key: String::new(),
+            layout_key: String::new(),
             light: SunLight::default(),
             default_extinction_per_m: DEFAULT_EXTINCTION_PER_M,
             lod: SpriteLod::Clusters,
@@ -132,30 +141,34 @@ impl Default for CloudSet {
 
 impl CloudSet {
     /// Takes `scene`'s settings and its hand-made and model-file clouds `authored` (with their
-    /// levels, None to derive them, as [`authored_clouds`] reads them); when the clouds depend on
-    /// anything that changed, every cloud is made again by the next [`CloudSet::update`].
+    /// levels, None to derive them, as [`authored_clouds`] reads them); the next
+    /// [`CloudSet::update`] makes again what depends on anything that changed. After an edit of
+    /// coverage alone the field's clouds are stale and remade as [`FieldTiles::update`] says.
     pub fn configure(&mut self, scene: &Scene, authored: &[Authored]) {
         let key = scene_key(scene, authored);
         if key == self.scene_key {
             return;
         }
         self.scene_key = key;
-        let draft_key = draft_key(scene);
-        if draft_key != self.draft_key {
-            self.draft_key = draft_key;
-            self.drafts.clear();
-        }
-        self.authored = authored.to_vec();
-        self.tiles.clear();
-        self.sprites.clear();
-        self.clouds.clear();
-        self.lod = scene.sprites.lod;
-        self.lit_by_volume = scene.lighting.model == crate::scene::LightingModel::Volume;
-        self.tiling = scene.sprites.field_clouds.then_some(FieldTiling {
+        let (draft_key, layout_key) = (draft_key(scene), layout_key(scene));
+        let tiling = scene.sprites.field_clouds.then_some(FieldTiling {
             tile_m: scene.sprites.cloud_size_m,
             distance_m: scene.sprites.distance_m,
             time_s: 0.0,
         });
+        match (self.field_tiles.as_mut(), tiling) {
+            (Some(tiles), Some(_)) if draft_key == self.draft_key => tiles.mark_stale(),
+            (_, tiling) => self.field_tiles = tiling.map(FieldTiles::new),
+        }
+        if (&draft_key, &layout_key) != (&self.draft_key, &self.layout_key) {
+            self.laid.clear();
+        }
+        (self.draft_key, self.layout_key) = (draft_key, layout_key);
+        self.authored = authored.to_vec();
+        self.sprites.clear();
+        self.clouds.clear();
+        self.lod = scene.sprites.lod;
+        self.lit_by_volume = scene.lighting.model == crate::scene::LightingModel::Volume;
         let g = PhaseLobes::from_scene(&scene.phase).mean_cosine();
         self.light = SunLight::from_scene(scene, Vec3::ZERO, g);
         self.default_extinction_per_m = scene
@@ -167,105 +180,91 @@ impl CloudSet {
     }
 
     /// Brings the set to this frame: makes the field clouds of tiles the camera reached (their
-    /// candidates' densities read by `reader`, at `time_s`), forgets those it left, and relights
-    /// the groups when the sun turned. Returns whether the records changed.
+    /// candidates' densities read by `reader`, at `time_s`), forgets those it left, remakes stale
+    /// ones (all, or within `refresh_budget` candidates: [`FieldTiles::update`]) and relights the
+    /// groups when the sun turned. Returns whether the records changed.
     pub fn update(
         &mut self,
         field: &CloudField,
         reader: &dyn CoarseFieldReader,
         (camera_m, sun): (Vec3, Vec3),
         time_s: f32,
+        refresh_budget: Option<usize>,
     ) -> bool {
-        let mut changed = self.sprites.is_empty() && self.clouds.is_empty();
-        if let Some(tiling) = self.tiling.as_mut() {
-            tiling.time_s = time_s;
-            let wanted = tiling.tiles_around(field, camera_m);
-            let keep: std::collections::BTreeSet<TileKey> = wanted.iter().copied().collect();
-            let before = self.tiles.len();
-            self.tiles.retain(|k, _| keep.contains(k));
-            self.drafts.retain(|k, _| keep.contains(k));
-            let undrafted: Vec<TileKey> = wanted
-                .iter()
-                .filter(|k| !self.drafts.contains_key(k))
-                .copied()
-                .collect();
-            let drafted: Vec<Option<TileDraft>> = {
-                use rayon::prelude::*;
-                undrafted
-                    .par_iter()
-                    .map(|&k| tiling.draft(field, k))
-                    .collect()
-            };
-            self.drafts.extend(undrafted.into_iter().zip(drafted));
-            let missing: Vec<TileKey> = wanted
-                .into_iter()
-                .filter(|k| !self.tiles.contains_key(k))
-                .collect();
-            changed |= self.tiles.len() != before || !missing.is_empty();
-            let drafts: Vec<Option<&TileDraft>> =
-                missing.iter().map(|k| self.drafts[k].as_ref()).collect();
-            let made = tiling.finish(field, &drafts, reader);
-            self.tiles.extend(missing.into_iter().zip(made));
+        let mut changed = TilesChanged::default();
+        if let Some(tiles) = self.field_tiles.as_mut() {
+            tiles.tiling.time_s = time_s;
+            changed = tiles.update(field, reader, camera_m, refresh_budget);
         }
         let lit = self.light.sun;
         let relight = lit.angle_between(sun) > SUN_TOLERANCE_RAD || lit == Vec3::ZERO;
-        if changed || relight {
-            self.light.sun = sun;
-            self.rebuild(field);
-            self.generation += 1;
-            return true;
+        let empty = self.sprites.is_empty() && self.clouds.is_empty();
+        if !(empty || changed.any() || relight) {
+            return false;
         }
-        false
+        self.light.sun = sun;
+        if relight && !self.lit_by_volume {
+            self.laid.clear();
+        }
+        for key in changed.removed.iter().chain(&changed.made) {
+            self.laid.remove(key);
+        }
+        self.rebuild(field);
+        self.generation += 1;
+        true
     }
 
-    /// Lays every cloud out again.
+    /// Field tiles whose cloud is still the one made before the last edit of coverage.
+    pub fn stale_tiles(&self) -> usize {
+        self.field_tiles.as_ref().map_or(0, FieldTiles::stale_count)
+    }
+
+    /// Lays out the field tiles not laid out yet and the hand-made clouds, and gathers every
+    /// cloud's records.
     fn rebuild(&mut self, field: &CloudField) {
-        let authored = self
-            .authored
+        let empty = BTreeMap::new();
+        let tiles = self.field_tiles.as_ref().map_or(&empty, |t| &t.tiles);
+        self.laid.retain(|k, _| tiles.contains_key(k));
+        let unlaid: Vec<(&TileKey, &Option<SpriteCloud>)> = tiles
             .iter()
-            .map(|(cloud, levels)| (cloud, *levels, false));
-        let from_field = self
-            .tiles
-            .values()
-            .flatten()
-            .map(|cloud| (cloud, None, true));
-        let all: Vec<Laid> = authored.chain(from_field).collect();
-        let (light, default_extinction) = (self.light, self.default_extinction_per_m);
-        let laid: Vec<(GpuCloud, Vec<GpuSprite>)> = {
+            .filter(|(k, _)| !self.laid.contains_key(k))
+            .collect();
+        let newly: Vec<Option<LaidCloud>> = {
             use rayon::prelude::*;
-            all.par_iter()
-                .map(|&placed| {
-                    let extinction = placed
-                        .0
-                        .layer
-                        .and_then(|l| field.layers.get(l as usize))
-                        .map_or(default_extinction, |l| l.extinction_per_m);
-                    self.lay_out(placed, field, &light.with_extinction(extinction))
-                })
+            unlaid
+                .par_iter()
+                .map(|(_, cloud)| cloud.as_ref().map(|c| self.lay_out((c, None, true), field)))
                 .collect()
         };
+        let keys: Vec<TileKey> = unlaid.iter().map(|(k, _)| **k).collect();
+        self.laid.extend(keys.into_iter().zip(newly));
+        let authored: Vec<LaidCloud> = self
+            .authored
+            .iter()
+            .map(|(cloud, levels)| self.lay_out((cloud, *levels, false), field))
+            .collect();
         self.sprites.clear();
         self.clouds.clear();
         self.cloud_centres.clear();
-        for (index, (cloud, sprites)) in laid.into_iter().enumerate() {
-            let placed = all[index].0;
-            self.cloud_centres
-                .push((placed.center_m, placed.layer.unwrap_or(NO_LAYER)));
-            self.clouds.push(cloud);
-            self.sprites.extend(sprites.into_iter().map(|mut s| {
-                s.cloud = index as u32;
-                s
+        let all = authored.iter().chain(self.laid.values().flatten());
+        for (index, laid) in all.enumerate() {
+            self.cloud_centres.push(laid.centre);
+            self.clouds.push(laid.cloud);
+            self.sprites.extend(laid.sprites.iter().map(|s| GpuSprite {
+                cloud: index as u32,
+                ..*s
             }));
         }
     }
 
-    /// One cloud's record and its sprites' (their `cloud` index set by the caller).
-    fn lay_out(
-        &self,
-        (placed, levels, from_field): Laid,
-        field: &CloudField,
-        light: &SunLight,
-    ) -> (GpuCloud, Vec<GpuSprite>) {
+    /// One cloud laid out for the GPU (its sprites' `cloud` index set by the caller), lit at
+    /// its layer's extinction.
+    fn lay_out(&self, (placed, levels, from_field): Laid, field: &CloudField) -> LaidCloud {
+        let extinction = placed
+            .layer
+            .and_then(|l| field.layers.get(l as usize))
+            .map_or(self.default_extinction_per_m, |l| l.extinction_per_m);
+        let light = &self.light.with_extinction(extinction);
         let billboard;
         let cloud = match self.lod {
             SpriteLod::Clusters => placed,
@@ -307,10 +306,11 @@ impl CloudSet {
                 }
             })
             .collect();
-        (
-            GpuCloud::new(&levels, cloud.center_m.y + lo, height),
+        LaidCloud {
+            cloud: GpuCloud::new(&levels, cloud.center_m.y + lo, height),
             sprites,
-        )
+            centre: (placed.center_m, layer),
+        }
     }
 
     /// The sun's light as last lit, at the extinction of clouds of no layer.
@@ -320,7 +320,7 @@ impl CloudSet {
 
     /// Whether the field's clouds are drawn.
     pub(super) fn has_field_clouds(&self) -> bool {
-        self.tiling.is_some()
+        self.field_tiles.is_some()
     }
 
     /// The hand-made and model-file clouds, with their colour levels (None: derived).
@@ -335,7 +335,11 @@ impl CloudSet {
         self.authored
             .iter()
             .map(|(cloud, _)| cloud.clone())
-            .chain(self.tiles.values().flatten().cloned())
+            .chain(
+                self.field_tiles
+                    .iter()
+                    .flat_map(|t| t.tiles.values().flatten().cloned()),
+            )
             .collect()
     }
 }
@@ -424,7 +428,14 @@ fn draft_key(scene: &Scene) -> String {
     )
 }
 
-/// What the clouds depend on besides the camera, time and sun: a change rebuilds them all.
+/// What laying the clouds out depends on besides the drafts and the sun: a change lays every
+/// cloud out again.
+fn layout_key(scene: &Scene) -> String {
+    format!("{:?}", (&scene.lighting, &scene.phase))
+}
+
+/// What the clouds depend on besides the camera, time and sun: a change makes again what depends
+/// on it ([`CloudSet::configure`]).
 fn scene_key(scene: &Scene, authored: &[Authored]) -> String {
     format!(
         "{:?}",

@@ -248,6 +248,11 @@ pub struct TileDraft {
 }
 
 impl TileDraft {
+    /// Its candidate sprites: what finishing it reads of the field.
+    pub fn candidates(&self) -> usize {
+        self.points_m.len()
+    }
+
     /// The cloud of the candidates where the field is cloudy (`extinctions_per_m`, one per
     /// candidate, of a layer whose densest extinction is `layer_extinction_per_m`), each sprite
     /// wide enough to overlap its neighbours and as opaque as the matter of its cell (puffs of

@@ -5,7 +5,8 @@
 //!
 //! - [`types`]: the ten cloud types and their recipes;
 //! - [`model`]: clouds from boxes, the fill-and-cull generator (the CPU specification);
-//! - [`from_field`]: clouds from the cloud field, in wind-borne tiles;
+//! - [`from_field`]: clouds from the cloud field, in wind-borne tiles, kept and remade by
+//!   [`field_tiles`];
 //! - [`textures`]: the 4 x 4 sheet of puffs, baked from the reference particle;
 //! - [`shading`]: colour levels, shading groups, directional and single-scattered light;
 //! - [`inside`]: the fog that stands for the sprites the eye has passed, inside a cloud;
@@ -13,6 +14,7 @@
 //! - [`cloud_set`], [`views`], [`impostors`], [`render`]: the technique on the GPU.
 
 pub mod cloud_set;
+pub(crate) mod field_tiles;
 pub mod file;
 pub(crate) mod from_field;
 pub mod impostors;

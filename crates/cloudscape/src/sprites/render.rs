@@ -10,6 +10,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{UVec2, Vec3, Vec4};
 
 use super::cloud_set::{Authored, CloudSet, GpuCloud, GpuSprite, authored_clouds};
+use super::field_tiles::REFRESH_CANDIDATES_PER_FRAME;
 use super::impostors::{ASPECT, SECTORS, SectorView};
 use super::inside::InCloudFog;
 use super::textures::{SHEET_TEXELS, sheet};
@@ -665,6 +666,7 @@ impl Technique for SpriteRenderer {
             &reader,
             (eye, frame.sun.direction),
             frame.time_s,
+            inputs.real_time.then_some(REFRESH_CANDIDATES_PER_FRAME),
         );
         self.upload_set(ctx);
         let offsets = wind_offsets_m(&configured.winds_m_per_s, frame.time_s);
