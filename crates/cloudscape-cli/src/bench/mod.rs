@@ -11,6 +11,8 @@ use clap::Args;
 use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, PassTimer};
 use cloudscape::renderer::{PASS_COUNT, Reuse, SceneRenderer};
+use cloudscape::scene::SceneDocument;
+use cloudscape::shadow::LightingReuse;
 use glam::UVec2;
 use serde::Serialize;
 
@@ -42,6 +44,12 @@ pub struct BenchArgs {
     /// (repeatable).
     #[arg(long, value_name = "KEY=VALUE,...")]
     variant: Vec<String>,
+    /// A live edit (comma-separated `KEY=VALUE`) made before every other timed frame and undone
+    /// before the rest, as a real-time host makes it (the lighting carried across frames): the
+    /// largest "prepare (CPU)" is what an edit costs the frame it lands in, e.g. `--technique
+    /// sprites --edit layers.0.coverage=0.7`.
+    #[arg(long, value_name = "KEY=VALUE,...", conflicts_with_all = ["soak", "flythrough"])]
+    edit: Option<String>,
     /// Soak: render at least this many frames at a small size (160x90 unless --width/--height)
     /// with temporal reuse, a moving camera and a live edit every `--soak-edit-every` frames, in
     /// whole cycles of the seven edits (so the end is in the state the start was), and fail if
@@ -66,6 +74,7 @@ struct Stat {
     mean_ms: f64,
     median_ms: f64,
     min_ms: f64,
+    max_ms: f64,
 }
 
 impl Stat {
@@ -77,6 +86,7 @@ impl Stat {
             mean_ms: mean,
             median_ms: samples[samples.len() / 2],
             min_ms: samples[0],
+            max_ms: samples[samples.len() - 1],
         }
     }
 }
@@ -104,6 +114,8 @@ struct Report {
     density_samples_per_pixel: f64,
     /// Particles (or other primitives) drawn in the last frame.
     primitives: Option<u32>,
+    /// Live edits made and undone during the timed frames (`--edit`).
+    edits: u32,
 }
 
 /// Runs the soak with `--soak`, the fly-through measurement with `--flythrough`, the
@@ -163,6 +175,7 @@ fn run_repeated(args: BenchArgs) -> Result<()> {
 fn time_frames(args: &BenchArgs, ctx: &GpuContext, extra: &[String]) -> Result<Report> {
     let frames = args.frames.unwrap_or(30);
     let doc = args.scene.load(extra)?;
+    let edited = edited_scene(args, extra)?;
     let scene = &doc.scene;
     let mut renderer = SceneRenderer::new(ctx, scene, &doc.resolve_path(""))
         .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))?;
@@ -170,10 +183,27 @@ fn time_frames(args: &BenchArgs, ctx: &GpuContext, extra: &[String]) -> Result<R
     let mut timer = PassTimer::new(ctx, PASS_COUNT);
     let names = renderer.pass_names();
     let reuse = args.temporal.map_or(Reuse::None, temporal_reuse);
+    if edited.is_some() {
+        renderer
+            .clouds()
+            .set_lighting_reuse(Some(LightingReuse::REAL_TIME));
+    }
     let mut pass_ms: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
     let (mut wall_ms, mut prepare_ms, mut first_prepare_cpu_ms) = (Vec::new(), Vec::new(), 0.0);
+    let mut edits = 0;
     for i in 0..args.warmup + frames {
         frame.frame_index = i;
+        if let Some(edited) = edited.as_ref().filter(|_| i >= args.warmup) {
+            let now = if (i - args.warmup).is_multiple_of(2) {
+                edited
+            } else {
+                &doc
+            };
+            renderer
+                .set_scene(ctx, &now.scene, &now.resolve_path(""))
+                .map_err(|e| anyhow!(now.error_at(&e.key_path, e.message)))?;
+            edits += 1;
+        }
         let wall = renderer.render_frame(ctx, &frame, reuse, &mut timer);
         let prepare = renderer.clouds().prepare_time().as_secs_f64() * 1e3;
         if i == 0 {
@@ -215,7 +245,18 @@ fn time_frames(args: &BenchArgs, ctx: &GpuContext, extra: &[String]) -> Result<R
         first_prepare_cpu_ms,
         density_samples_per_pixel: stats.map_or(0.0, |s| s.density_samples_per_pixel),
         primitives: stats.and_then(|s| s.primitives),
+        edits,
     })
+}
+
+/// The scene with `extra` and `--edit`'s overrides, when there is an edit.
+fn edited_scene(args: &BenchArgs, extra: &[String]) -> Result<Option<SceneDocument>> {
+    let Some(edit) = &args.edit else {
+        return Ok(None);
+    };
+    let edit = edit.split(',').map(str::to_string);
+    let overrides: Vec<String> = extra.iter().cloned().chain(edit).collect();
+    Ok(Some(args.scene.load(&overrides)?))
 }
 
 /// Whether the adapter is a CPU (software) one, whose timestamp queries do not time shaders.
@@ -236,8 +277,8 @@ fn print_report(report: &Report) {
         );
     }
     println!(
-        "{:<22} {:>10} {:>10} {:>10}",
-        "pass", "mean ms", "median ms", "min ms"
+        "{:<22} {:>10} {:>10} {:>10} {:>10}",
+        "pass", "mean ms", "median ms", "min ms", "max ms"
     );
     for s in report
         .passes
@@ -245,14 +286,20 @@ fn print_report(report: &Report) {
         .chain([&report.frame_wall, &report.prepare_cpu])
     {
         println!(
-            "{:<22} {:>10.3} {:>10.3} {:>10.3}",
-            s.name, s.mean_ms, s.median_ms, s.min_ms
+            "{:<22} {:>10.3} {:>10.3} {:>10.3} {:>10.3}",
+            s.name, s.mean_ms, s.median_ms, s.min_ms, s.max_ms
         );
     }
     println!(
         "first frame's prepare (CPU): {:.1} ms (what the technique builds on the CPU for the scene)",
         report.first_prepare_cpu_ms
     );
+    if report.edits > 0 {
+        println!(
+            "live edits: {} (made and undone in turn, one before each timed frame)",
+            report.edits
+        );
+    }
     let samples = report.density_samples_per_pixel;
     match report.primitives {
         Some(n) => println!("primitives drawn: {n}; blended per pixel: {samples:.1}"),

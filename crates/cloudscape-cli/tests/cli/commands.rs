@@ -245,11 +245,58 @@ fn bench_json_reports_each_pass_and_the_frame_wall_time() {
             .expect("first prepare");
         assert!(prepare.is_some_and(|ms| ms >= 0.0), "{report}");
         assert!(technique != "sprites" || first > 0.0, "{report}");
+        assert_eq!(report["edits"], 0);
     }
     assert!(reports[0]["primitives"].is_null());
     assert!(reports[1]["primitives"].as_u64().is_some_and(|n| n > 1000));
     assert!(reports[2]["primitives"].as_u64().is_some_and(|n| n > 100));
     assert!(scratch.file_names().is_empty(), "bench wrote a file");
+}
+
+/// `bench --edit` makes the edit before every other timed frame and undoes it before the rest,
+/// and reports the frame an edit lands in as the prepare's largest time.
+#[test]
+fn bench_edit_makes_and_undoes_a_live_edit_between_frames() {
+    let scratch = Scratch::new("bench-edit");
+    let mut args = vec![
+        "bench",
+        "--technique",
+        "sprites",
+        "--frames",
+        "3",
+        "--warmup",
+        "1",
+    ];
+    args.extend([
+        "--edit",
+        "layers.0.coverage=0.2",
+        "--temporal",
+        "2",
+        "--json",
+    ]);
+    args.extend(["--set", "sprites.distance_m=8000"]);
+    args.extend(TINY);
+    let run = cloudscape(scratch.path(), &args, true);
+    assert!(run.success, "{}", run.stderr);
+    let reports: serde_json::Value = serde_json::from_str(&run.stdout).expect("JSON on stdout");
+    let report = &reports[0];
+    assert_eq!(report["edits"], 3, "{report}");
+    let prepare = &report["prepare_cpu"];
+    let (median, max) = (prepare["median_ms"].as_f64(), prepare["max_ms"].as_f64());
+    assert!(
+        median.zip(max).is_some_and(|(m, x)| x >= m && m > 0.0),
+        "{report}"
+    );
+    let bad = cloudscape(
+        scratch.path(),
+        &["bench", "--edit", "layers.0.coverage=2"],
+        true,
+    );
+    assert!(
+        !bad.success && bad.stderr.contains("layers.0.coverage"),
+        "{}",
+        bad.stderr
+    );
 }
 
 /// `scenes/flythrough.toml` of the repository, as an absolute path.

@@ -453,6 +453,50 @@ mod tests {
     use crate::gpu::layout_check::assert_wgsl_layout;
 
     #[test]
+    fn after_an_edit_of_coverage_the_records_are_a_stills_once_every_tile_is_remade() {
+        let scene = |coverage: f32| {
+            let mut scene = Scene::default();
+            scene.layers[0].coverage = coverage;
+            scene.sprites.distance_m = 4000.0;
+            scene
+        };
+        let (before, after) = (scene(0.35), scene(0.6));
+        let fields = [&before, &after].map(|s| CloudField::new(s, Path::new(".")).unwrap());
+        let read = |field| CpuCoarseReader { field, time_s: 0.0 };
+        let view = (
+            Vec3::new(0.0, 1200.0, 0.0),
+            Vec3::new(0.3, 0.5, 0.2).normalize(),
+        );
+        let mut live = CloudSet::default();
+        live.configure(&before, &[]);
+        assert!(live.update(&fields[0], &read(&fields[0]), view, 0.0, Some(1)));
+        let old_sprites = live.sprites.len();
+        live.configure(&after, &[]);
+        let stale = live.stale_tiles();
+        assert!(stale > 1);
+        assert!(live.update(&fields[1], &read(&fields[1]), view, 0.0, Some(1)));
+        assert_eq!(
+            live.stale_tiles(),
+            stale - 1,
+            "one tile a frame at the least budget"
+        );
+        assert!(
+            live.sprites.len() >= old_sprites,
+            "the old clouds are drawn until remade"
+        );
+        while live.stale_tiles() > 0 {
+            assert!(live.update(&fields[1], &read(&fields[1]), view, 0.0, Some(1)));
+        }
+        let mut still = CloudSet::default();
+        still.configure(&after, &[]);
+        still.update(&fields[1], &read(&fields[1]), view, 0.0, None);
+        assert_eq!(live.sprites, still.sprites);
+        assert_eq!(live.clouds, still.clouds);
+        assert_eq!(live.cloud_centres, still.cloud_centres);
+        assert!(!live.update(&fields[1], &read(&fields[1]), view, 0.0, Some(1)));
+    }
+
+    #[test]
     fn sprite_records_match_their_wgsl_layout() {
         assert_wgsl_layout!(
             &crate::sprites::render::SPRITE_RENDER_WGSL,

@@ -158,3 +158,86 @@ impl FieldTiles {
         centre.distance(eye)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::field::CpuCoarseReader;
+    use crate::scene::Scene;
+    use std::path::Path;
+
+    fn field(coverage: f32) -> CloudField {
+        let mut scene = Scene::default();
+        scene.layers[0].coverage = coverage;
+        CloudField::new(&scene, Path::new(".")).expect("the default scene's field")
+    }
+
+    fn reader(field: &CloudField) -> CpuCoarseReader<'_> {
+        CpuCoarseReader { field, time_s: 0.0 }
+    }
+
+    const TILING: FieldTiling = FieldTiling {
+        tile_m: 1500.0,
+        distance_m: 5000.0,
+        time_s: 0.0,
+    };
+
+    #[test]
+    fn stale_clouds_are_remade_nearest_first_within_the_budget() {
+        let (thin, thick) = (field(0.35), field(0.6));
+        let eye = Vec3::new(700.0, 1200.0, -300.0);
+        let mut tiles = FieldTiles::new(TILING);
+        let first = tiles.update(&thin, &reader(&thin), eye, Some(1));
+        assert_eq!(
+            first.made.len(),
+            tiles.tiles.len(),
+            "new tiles are made at once"
+        );
+        tiles.mark_stale();
+        let total: usize = tiles
+            .drafts
+            .values()
+            .flatten()
+            .map(TileDraft::candidates)
+            .sum();
+        let budget = total / 4;
+        let mut frames = 0;
+        while tiles.stale_count() > 0 {
+            let stale_before: Vec<TileKey> = tiles.stale.iter().copied().collect();
+            let made = tiles
+                .update(&thick, &reader(&thick), eye, Some(budget))
+                .made;
+            let spent: usize = made
+                .iter()
+                .map(|k| tiles.drafts[k].as_ref().map_or(0, TileDraft::candidates))
+                .sum();
+            assert!(
+                made.len() == 1 || spent <= budget,
+                "{spent} candidates over {budget}"
+            );
+            let reach = made
+                .iter()
+                .map(|&k| tiles.distance_m(&thick, k, eye))
+                .fold(0.0, f32::max);
+            for k in stale_before.iter().filter(|k| tiles.stale.contains(k)) {
+                assert!(
+                    tiles.distance_m(&thick, *k, eye) >= reach,
+                    "a nearer tile was left stale"
+                );
+            }
+            frames += 1;
+            assert!(frames < 100);
+        }
+        assert!(
+            frames >= 4,
+            "{frames} frames for a quarter of the candidates each"
+        );
+        let mut still = FieldTiles::new(TILING);
+        still.update(&thick, &reader(&thick), eye, None);
+        assert_eq!(
+            format!("{:?}", tiles.tiles),
+            format!("{:?}", still.tiles),
+            "remade over frames, the clouds are those a still makes"
+        );
+    }
+}
