@@ -152,8 +152,7 @@ fn sample(
     let t = tracer.volume.free_flight(origin, dir, RAY_REACH_M, rng)?;
     let p = origin + dir * t;
     // The march's light samples, at the middle of each segment.
-    let eroded = MarchSettings::eroded_light_steps(Quality::High);
-    let tau_sun = light::sun_optical_depth(field, p, sun, (light_steps, eroded, 0.5), 0.0);
+    let tau_sun = light::sun_optical_depth(field, p, sun, (light_steps, 0.5), 0.0);
     let tau_back = light::back_optical_depth(field, p, sun, (back_steps(light_steps), 0.5), 0.0);
     let (source, source_error) = mean_and_error(paths, || tracer.source_radiance(p, dir, rng).y);
     Some(Sample {

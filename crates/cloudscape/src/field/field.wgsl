@@ -276,12 +276,12 @@ fn field_volume_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
     return hull;
 }
 
-// Optical depth of the field along p + t dir over t in [span.x, span.x + span.y], from n segments
-// whose lengths grow by the factor span.z from one to the next (2: Schneider 2015's doubling light
-// samples, fine near p; 1: uniform), each sampled at a jittered point; the segments' offsets are
-// decorrelated from `jitter` and from each other by the golden ratio. The first `eroded` segments
-// read the eroded field, the rest the coarse (uneroded) one: CloudField::optical_depth.
-fn field_optical_depth(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: u32, jitter: f32, eroded: u32) -> f32 {
+// Optical depth of the coarse (uneroded) field along p + t dir over t in [span.x, span.x + span.y],
+// from n segments whose lengths grow by the factor span.z from one to the next (2: Schneider 2015's
+// doubling light samples, fine near p; 1: uniform), each sampled at a jittered point; the segments'
+// offsets are decorrelated from `jitter` and from each other by the golden ratio:
+// CloudField::coarse_optical_depth.
+fn field_optical_depth_coarse(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: u32, jitter: f32) -> f32 {
     var total = f32(n);
     if span.z != 1.0 {
         total = (pow(span.z, f32(n)) - 1.0) / (span.z - 1.0);
@@ -291,21 +291,9 @@ fn field_optical_depth(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: u32, ji
     var tau = 0.0;
     for (var k = 0u; k < n; k++) {
         let offset = fract(jitter + f32(k + 1u) * GOLDEN_RATIO_CONJUGATE);
-        let q = p + dir * (start + width * offset);
-        var extinction: f32;
-        if k < eroded {
-            extinction = field_extinction(q);
-        } else {
-            extinction = field_extinction_coarse(q);
-        }
-        tau += extinction * width;
+        tau += field_extinction_coarse(p + dir * (start + width * offset)) * width;
         start += width;
         width *= span.z;
     }
     return tau;
-}
-
-// field_optical_depth of the coarse field alone: CloudField::coarse_optical_depth.
-fn field_optical_depth_coarse(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: u32, jitter: f32) -> f32 {
-    return field_optical_depth(p, dir, span, n, jitter, 0u);
 }

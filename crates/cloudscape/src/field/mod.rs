@@ -271,16 +271,16 @@ impl CloudField {
         self.extinction(p, time_s, Detail::Coarse)
     }
 
-    /// Optical depth of the field along `p + t dir` over `t` in `[start_m, start_m + length_m]`,
-    /// from `n` segments whose lengths grow by `growth` from one to the next (2: Schneider 2015's
-    /// doubling light samples, fine near `p`; 1: uniform), each sampled at a point offset by
-    /// `jitter` and decorrelated from the others by the golden ratio; the first `eroded` segments
-    /// read the eroded field, the rest the coarse one: `field_optical_depth` in `field.wgsl`.
-    pub fn optical_depth(
+    /// Optical depth of the coarse field along `p + t dir` over `t` in `[start_m, start_m +
+    /// length_m]`, from `n` segments whose lengths grow by `growth` from one to the next (2:
+    /// Schneider 2015's doubling light samples, fine near `p`; 1: uniform), each sampled at a point
+    /// offset by `jitter` and decorrelated from the others by the golden ratio:
+    /// `field_optical_depth_coarse` in `field.wgsl`.
+    pub fn coarse_optical_depth(
         &self,
         (p, dir): (Vec3, Vec3),
         (start_m, length_m, growth): (f32, f32, f32),
-        (n, jitter, eroded): (u32, f32, u32),
+        (n, jitter): (u32, f32),
         time_s: f32,
     ) -> f32 {
         let total = if growth == 1.0 {
@@ -291,28 +291,11 @@ impl CloudField {
         let (mut width, mut start, mut tau) = (length_m / total, start_m, 0.0);
         for k in 0..n {
             let offset = (jitter + (k + 1) as f32 * GOLDEN_RATIO_CONJUGATE).fract();
-            let q = p + dir * (start + width * offset);
-            let detail = if k < eroded {
-                Detail::Eroded
-            } else {
-                Detail::Coarse
-            };
-            tau += self.extinction(q, time_s, detail) * width;
+            tau += self.coarse_extinction_per_m(p + dir * (start + width * offset), time_s) * width;
             start += width;
             width *= growth;
         }
         tau
-    }
-
-    /// [`CloudField::optical_depth`] of the coarse field alone: `field_optical_depth_coarse`.
-    pub fn coarse_optical_depth(
-        &self,
-        ray: (Vec3, Vec3),
-        span: (f32, f32, f32),
-        (n, jitter): (u32, f32),
-        time_s: f32,
-    ) -> f32 {
-        self.optical_depth(ray, span, (n, jitter, 0), time_s)
     }
 
     /// Lowest and highest world heights of the clouds at the origin, and whether there are any.

@@ -63,8 +63,7 @@ pub enum ProbeFunction {
     /// `slab_scattering(SlabModel(lobes a, params b), cos theta c.x, tau_sun c.y, tau_back c.z)`:
     /// `SunSlab::scattering`.
     SunSlab = 22,
-    /// `march_sun_optical_depth(a.xyz, steps (b.x, eroded b.z), jitter b.y)`:
-    /// `raymarch::light::sun_optical_depth`.
+    /// `march_sun_optical_depth(a.xyz, steps b.x, jitter b.y)`: `raymarch::light::sun_optical_depth`.
     MarchSunOpticalDepth = 23,
     /// `march_back_optical_depth(a.xyz, steps b.x, jitter b.y)`:
     /// `raymarch::light::back_optical_depth`.

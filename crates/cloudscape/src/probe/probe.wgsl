@@ -41,7 +41,7 @@ fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>) ->
         case 20u: { return vec4<f32>(frame_two_stream_share_from_below(a.x, a.y)); }
         case 21u: { return vec4<f32>(phase_octaves(a, b.xyz, u32(c.z), c.x, c.y)); }
         case 22u: { return vec4<f32>(slab_scattering(SlabModel(a, b), c.x, c.y, c.z)); }
-        case 23u: { return vec4<f32>(march_sun_optical_depth(a.xyz, vec2<u32>(u32(b.x), u32(b.z)), b.y)); }
+        case 23u: { return vec4<f32>(march_sun_optical_depth(a.xyz, u32(b.x), b.y)); }
         case 24u: { return vec4<f32>(march_back_optical_depth(a.xyz, u32(b.x), b.y)); }
         case 25u: {
             let merged = blend_merge(BlendSegment(a.x, a.y, a.z, b.xyz), BlendSegment(c.x, c.y, c.z, d.xyz));

@@ -2,18 +2,17 @@
 // their step counts as arguments: no bindings of their own, so the probe evaluates them as the
 // march does (raymarch/light.rs is their CPU twin).
 
-// Optical depth toward the sun from p: steps.x segments whose lengths double, the nearest steps.y
-// through the eroded density (MarchSettings::eroded_light_steps) and the rest through the coarse
-// (uneroded) one as Schneider 2015's cheap light samples, covering the way to the top of the
+// Optical depth toward the sun from p, through the coarse (uneroded) density as Schneider 2015's
+// cheap light samples: `steps` segments whose lengths double, covering the way to the top of the
 // layers (MARCH_SUN_PATH_MIN_M..MARCH_SUN_PATH_MAX_M, raymarch::SUN_PATH_M) (VolumeCloud samples
 // the sun path at 0.5, 1.5, 3, 6, 12 units with weights 1, 1, 2, 4, 8; peers.md).
-fn march_sun_optical_depth(p: vec3<f32>, steps: vec2<u32>, jitter: f32) -> f32 {
+fn march_sun_optical_depth(p: vec3<f32>, steps: u32, jitter: f32) -> f32 {
     let sun = environment_sun_direction();
     var length_m = MARCH_SUN_PATH_MAX_M;
     if field.layer_count > 0u {
         length_m = clamp(field_below(p, sun, field.layer_top_m).y, MARCH_SUN_PATH_MIN_M, MARCH_SUN_PATH_MAX_M);
     }
-    return field_optical_depth(p, sun, vec3<f32>(0.0, length_m, 2.0), steps.x, jitter, steps.y);
+    return field_optical_depth_coarse(p, sun, vec3<f32>(0.0, length_m, 2.0), steps, jitter);
 }
 
 // Optical depth away from the sun from p, through the coarse density, to where the path leaves the

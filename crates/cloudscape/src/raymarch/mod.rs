@@ -35,8 +35,6 @@ pub struct MarchSettings {
     pub primary_steps: u32,
     /// Samples toward the sun from each view sample.
     pub light_steps: u32,
-    /// Of those, the nearest that read the eroded density ([`MarchSettings::eroded_light_steps`]).
-    pub eroded_light_steps: u32,
     /// Jittered marches averaged per pixel.
     pub samples_per_pixel: u32,
     /// Which model of the sun's multiply scattered light the march uses.
@@ -76,24 +74,6 @@ impl MarchSettings {
         }
     }
 
-    /// Segments of the path toward the sun, nearest the sample first, that read the eroded
-    /// density at a quality preset (at most its light steps); the rest read the coarse one
-    /// (Schneider 2015's cheap light samples). With six doubling segments over a 4 km path the
-    /// first two cover its first 190 m, where the detail noise's erosion of a cloud's edge decides
-    /// how much sunlight reaches a lit surface: the coarse density is an upper bound of the eroded
-    /// one (erosion only removes density), so read there alone it dims every lit face. The far
-    /// segments, deep in the cloud, keep the smooth coarse density: a few samples of the eroded one
-    /// there would make `exp(-tau)` noisy and, the exponential being convex, brighter on average.
-    /// Each eroded segment costs the march about a sixth more (`docs/lighting.md`, "The sun's
-    /// path"), so the cheaper presets read fewer.
-    pub fn eroded_light_steps(quality: Quality) -> u32 {
-        match quality {
-            Quality::Low => 0,
-            Quality::Medium => 1,
-            Quality::High | Quality::Ultra => 2,
-        }
-    }
-
     /// Steps of a quality preset: (primary, light, samples per pixel).
     pub fn preset(quality: Quality) -> (u32, u32, u32) {
         match quality {
@@ -114,7 +94,6 @@ impl MarchSettings {
         MarchSettings {
             primary_steps: r.primary_steps.unwrap_or(primary),
             light_steps,
-            eroded_light_steps: Self::eroded_light_steps(r.quality).min(light_steps),
             samples_per_pixel: r.samples_per_pixel.unwrap_or(spp),
             model: l.model,
             slab: l.sun_slab(phase),
@@ -154,9 +133,6 @@ struct MarchUniform {
     back_steps: u32,
     view_peak_weight: f32,
     slab_params: Vec4,
-    eroded_light_steps: u32,
-    reserved: u32,
-    reserved_pair: UVec2,
 }
 
 impl MarchUniform {
@@ -181,7 +157,6 @@ impl MarchUniform {
             },
             back_steps: settings.back_steps(),
             view_peak_weight: settings.view_peak_weight(),
-            eroded_light_steps: settings.eroded_light_steps,
             slab_params: Vec4::from_array(settings.slab.params_to_gpu()),
             ..MarchUniform::zeroed()
         }
@@ -390,9 +365,6 @@ mod tests {
                 back_steps,
                 view_peak_weight,
                 slab_params,
-                eroded_light_steps,
-                reserved,
-                reserved_pair,
             }
         );
         assert_wgsl_layout!(

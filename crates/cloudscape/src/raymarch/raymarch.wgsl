@@ -20,9 +20,6 @@ struct March {
     back_steps: u32,            // samples away from the sun from each view sample (slab)
     view_peak_weight: f32,      // MarchSettings::view_peak_weight: scattering that keeps light on the ray
     slab_params: vec4<f32>,     // SunSlab::params_to_gpu
-    eroded_light_steps: u32,    // the nearest light samples that read the eroded density
-    reserved: u32,
-    reserved_pair: vec2<u32>,
 }
 
 struct MarchResult {
@@ -197,7 +194,7 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
         if sigma_t <= 0.0 {
             continue;
         }
-        let tau_sun = march_sun_optical_depth(p, vec2<u32>(march.light_steps, march.eroded_light_steps), jitter);
+        let tau_sun = march_sun_optical_depth(p, march.light_steps, jitter);
         let sun = albedo * march_sun_scattering(p, d, tau_sun, jitter, reads_volume) * light.sun;
         let diffuse = albedo * (1.0 - peak) * march_diffuse(p, d, light, reads_volume);
         let step_transmittance = exp(-sigma_t * dt);
