@@ -142,8 +142,9 @@ impl Default for CloudSet {
 impl CloudSet {
     /// Takes `scene`'s settings and its hand-made and model-file clouds `authored` (with their
     /// levels, None to derive them, as [`authored_clouds`] reads them); the next
-    /// [`CloudSet::update`] makes again what depends on anything that changed. After an edit of
-    /// coverage alone the field's clouds are stale and remade as [`FieldTiles::update`] says.
+    /// [`CloudSet::update`] makes again what depends on anything that changed. After an edit that
+    /// keeps the drafts (coverage, lighting, the phase function) the field's clouds are stale and
+    /// remade as [`FieldTiles::update`] says.
     pub fn configure(&mut self, scene: &Scene, authored: &[Authored]) {
         let key = scene_key(scene, authored);
         if key == self.scene_key {

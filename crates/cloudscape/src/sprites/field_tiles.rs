@@ -56,7 +56,7 @@ impl FieldTiles {
         }
     }
 
-    /// After an edit of the field's density alone (coverage): every cloud is stale, drafts kept.
+    /// After an edit that keeps the drafts (the field's density: coverage): every cloud is stale.
     pub fn mark_stale(&mut self) {
         self.stale.extend(self.tiles.keys().copied());
     }
