@@ -182,7 +182,7 @@ fn scene_row(
     let name = canonical.name;
     let image_path = |kind: &str| images.join(format!("{name}-{kind}.png"));
     let (ev, op) = (doc.scene.render.exposure_ev, doc.scene.render.tonemap);
-    write_image(&image_path("reference"), &full, ev, op)?;
+    write_image(&image_path("reference"), &full.clone().opaque(), ev, op)?;
     let sources = particles::Sources {
         store,
         budget: budget(args),

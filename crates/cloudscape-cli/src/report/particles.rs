@@ -87,7 +87,12 @@ pub fn row(
     let path = |kind: &str| images.join(format!("{name}-{kind}.png"));
     m.write_images(field, &path("particles"), &path("particles-flip"))?;
     let (ev, op) = (scene.render.exposure_ev, scene.render.tonemap);
-    write_image(&path("particle-reference"), &traced, ev, op)?;
+    write_image(
+        &path("particle-reference"),
+        &traced.clone().opaque(),
+        ev,
+        op,
+    )?;
     let row = ParticleRow {
         total: m.comparison.clone(),
         lighting: Comparison::of(&traced, &m.rendered.hdr, None)?,

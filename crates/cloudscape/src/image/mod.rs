@@ -143,6 +143,14 @@ impl HdrImage {
         }
     }
 
+    /// The same radiance with alpha 1: what a display should show of an image whose colour is
+    /// already composited over its background and whose alpha is a mask (the path tracer's cloud
+    /// coverage), which a viewer would otherwise blend over white.
+    pub fn opaque(mut self) -> HdrImage {
+        self.pixels.iter_mut().for_each(|p| p[3] = 1.0);
+        self
+    }
+
     /// The display image: exposure by `exposure_ev` stops, tone mapping by `op`, sRGB encoding;
     /// alpha is quantised linearly.
     pub fn to_ldr(&self, exposure_ev: f32, op: Tonemap) -> LdrImage {
@@ -244,6 +252,16 @@ mod tests {
         let ldr = hdr.to_ldr(0.0, Tonemap::Aces);
         assert_eq!((ldr.width, ldr.height), (2, 1));
         assert_eq!(ldr.pixels, vec![[0, 0, 0, 0], [255, 255, 255, 128]]);
+    }
+
+    #[test]
+    fn an_opaque_image_keeps_its_radiance_and_drops_its_mask() {
+        let masked = hdr_sample();
+        let opaque = masked.clone().opaque();
+        for (o, m) in opaque.pixels.iter().zip(&masked.pixels) {
+            assert_eq!((o[..3].to_vec(), o[3]), (m[..3].to_vec(), 1.0));
+        }
+        assert!(masked.pixels.iter().any(|p| p[3] < 1.0));
     }
 
     #[test]
