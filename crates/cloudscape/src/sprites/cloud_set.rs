@@ -207,7 +207,8 @@ impl CloudSet {
         if relight && !self.lit_by_volume {
             self.laid.clear();
         }
-        for key in changed.removed.iter().chain(&changed.made) {
+        // Tiles the camera left go in `rebuild`, with every tile no longer made.
+        for key in &changed.made {
             self.laid.remove(key);
         }
         self.rebuild(field);
