@@ -397,20 +397,3 @@ mod tests {
         assert!((tex.sample(centre(4.5) + Vec3::X) - t0).abs().max_element() < 1e-5);
     }
 }
-#[cfg(test)]
-mod scratch_stats {
-    use super::*;
-    #[test]
-    fn scratch_detail_corr() {
-        let t = NoiseKind::Detail.bake(1);
-        let m = |x: IVec3| { let v = t.fetch(x); v.x*0.625+v.y*0.25+v.z*0.125 };
-        let n = 32; let mut mean=0.0; let mut c=0;
-        for z in 0..n { for y in 0..n { for x in 0..n { mean += m(IVec3::new(x,y,z)); c+=1; }}}
-        mean /= c as f32;
-        for lag in [0,1,2,3,4,5,6,8,10,12,16] {
-            let mut s=0.0; let mut s0=0.0;
-            for z in 0..n { for y in 0..n { for x in 0..n { let a=m(IVec3::new(x,y,z))-mean; let b=m(IVec3::new(x,y+lag,z))-mean; let b2=m(IVec3::new(x+lag,y,z))-mean; s+=a*(b+b2)*0.5; s0+=a*a; }}}
-            println!("lag {lag} texels ({} m) r {}", lag as f32*700.0/32.0, s/s0);
-        }
-    }
-}
