@@ -142,7 +142,12 @@ impl DetailStatistics {
         };
         let n = detail.texels.len() as f64;
         let mean = detail.texels.iter().map(fbm).sum::<f64>() / n;
-        let variance = detail.texels.iter().map(|t| (fbm(t) - mean).powi(2)).sum::<f64>() / n;
+        let variance = detail
+            .texels
+            .iter()
+            .map(|t| (fbm(t) - mean).powi(2))
+            .sum::<f64>()
+            / n;
         DetailStatistics {
             fbm_mean: mean as f32,
             fbm_sd: variance.sqrt() as f32,
