@@ -133,7 +133,8 @@ fn coarse_field_and_its_light_paths_match_the_cpu() {
     let cpu = CpuCoarseReader { field, time_s: 0.0 };
     assert_eq!(cpu.coarse_extinctions_per_m(&points), want);
 
-    // Light paths: doubling segments toward the sun and uniform ones up from the ground.
+    // Light paths through the mean density: doubling segments toward the sun and uniform ones up
+    // from the ground.
     let sun = Environment::from_scene(&scene).sun.direction;
     let paths: Vec<(Vec3, Vec3, f32, f32)> = (0..200)
         .map(|i| {
@@ -149,12 +150,12 @@ fn coarse_field_and_its_light_paths_match_the_cpu() {
         .iter()
         .map(|(p, d, len, growth)| input(p.extend(*len), d.extend(*growth)))
         .collect();
-    let got = gpu(&ctx, &clouds, ProbeFunction::CoarseOpticalDepth, &inputs);
+    let got = gpu(&ctx, &clouds, ProbeFunction::MeanOpticalDepth, &inputs);
     let mut errors: Vec<f32> = paths
         .iter()
         .zip(&got)
         .map(|((p, d, len, growth), g)| {
-            let want = field.coarse_optical_depth((*p, *d), (0.0, *len, *growth), (16, 0.5), 0.0);
+            let want = field.mean_optical_depth((*p, *d), (0.0, *len, *growth), (16, 0.5), 0.0);
             (g.x - want).abs() / want.max(1.0)
         })
         .collect();
@@ -163,7 +164,7 @@ fn coarse_field_and_its_light_paths_match_the_cpu() {
     let (p95, worst) = (errors[errors.len() * 95 / 100], errors[errors.len() - 1]);
     assert!(
         p95 < 0.02 && worst < 0.15,
-        "coarse optical depth differs by p95 {p95}, worst {worst} (relative)"
+        "mean optical depth differs by p95 {p95}, worst {worst} (relative)"
     );
 
     // The march's light paths: toward the sun to the top of the layer, away from it to the bottom.

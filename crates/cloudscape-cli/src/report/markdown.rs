@@ -223,10 +223,9 @@ fn targets_section(s: &mut String, rows: &[Row]) {
          hours above on this machine's two cores; the stored references are extended run after run \
          with `--spp`. Why the ray marcher stays above its target: a comparison with a noisy \
          reference cannot fall far below its noise (the column above the noise is the part the \
-         reference resolves), and the rest is the model's: a few coarse samples toward and away \
-         from the sun stand for the whole light path, and the slab model's two fitted factors \
-         leave a relative RMS of about 1.2 on the sun's multiply scattered light at single \
-         points of held-out scenes (`docs/lighting.md`)."
+         reference resolves), and the rest is the model's: the diffuse light comes from a light \
+         volume of cells hundreds of metres wide, and the light paths read the eroded density's \
+         mean over the detail noise, not the density itself (`docs/lighting.md`)."
     );
 }
 

@@ -42,6 +42,8 @@ struct Field {
     volume_count: u32,
     hiheight_level_count: u32,
     atlas_bricks_xy: vec2<u32>,   // bricks along x and y of the volume atlas
+    detail_fbm: vec2<f32>,        // the detail fBm's mean and standard deviation (DetailStatistics)
+    reserved: vec2<f32>,
     layers: array<FieldLayer, MAX_LAYERS>,
     volumes: array<FieldVolume, MAX_VOLUMES>,
     hiheight_levels: array<vec4<u32>, MAX_HIHEIGHT_LEVELS>, // per level: first cell, width, height
@@ -159,9 +161,27 @@ fn field_erode(density: f32, detail: vec4<f32>, f: f32, erosion: f32) -> f32 {
     return clamp(field_remap(density, modifier * erosion, 1.0, 0.0, 1.0), 0.0, 1.0);
 }
 
+// The eroded density's mean over the detail noise: layer::mean_erode, which derives it.
+fn field_mean_erode(density: f32, f: f32, erosion: f32) -> f32 {
+    let blend = clamp(f * 10.0, 0.0, 1.0);
+    let mu = mix(field.detail_fbm.x, 1.0 - field.detail_fbm.x, blend) * erosion;
+    let s = max(abs(1.0 - 2.0 * blend) * field.detail_fbm.y * erosion, 1e-6);
+    let z = clamp((density - mu) / s, -8.0, 8.0);
+    let pdf = 0.39894228 * exp(-0.5 * z * z); // the normal density, 1 / sqrt(2 pi) at 0
+    let cdf = 1.0 / (1.0 + exp(-(0.07056 * z * z * z + 1.5976 * z)));
+    return clamp(((density - mu) * cdf + s * pdf) / (1.0 - mu), 0.0, 1.0);
+}
+
+// Which density field_layer_extinction returns: eroded by the detail noise, its mean over the
+// noise (the light paths'), or uneroded (the coarse shapes').
+const FIELD_ERODED: u32 = 0u;
+const FIELD_MEAN: u32 = 1u;
+const FIELD_COARSE: u32 = 2u;
+
 // Extinction of layer `layer` (an index: its members are read from the uniform where used rather
-// than copied, which the march feels) at p, altitude h: CloudField::layer_extinction.
-fn field_layer_extinction(layer: u32, p: vec3<f32>, h: f32, eroded: bool) -> f32 {
+// than copied, which the march feels) at p, altitude h, of the density `density` (FIELD_ERODED,
+// FIELD_MEAN or FIELD_COARSE): CloudField::layer_extinction.
+fn field_layer_extinction(layer: u32, p: vec3<f32>, h: f32, density: u32) -> f32 {
     let f = (h - field.layers[layer].bottom_m) / field.layers[layer].thickness_m;
     if f < 0.0 || f > 1.0 {
         return 0.0;
@@ -186,8 +206,11 @@ fn field_layer_extinction(layer: u32, p: vec3<f32>, h: f32, eroded: bool) -> f32
     if covered <= 0.0 {
         return 0.0;
     }
-    if !eroded {
+    if density == FIELD_COARSE {
         return min(covered, 1.0) * w.z * field.layers[layer].extinction_per_m;
+    }
+    if density == FIELD_MEAN {
+        return field_mean_erode(min(covered, 1.0), f, field.detail_erosion) * w.z * field.layers[layer].extinction_per_m;
     }
     let curl = textureSampleLevel(field_curl_noise, field_repeat_linear, q.xz / field.base_noise_period_m, 0.0);
     let swirl = (curl.xy * 2.0 - 1.0) * field.curl_displacement_m * (1.0 - f);
@@ -218,11 +241,11 @@ fn field_volume_extinction(v: FieldVolume, p: vec3<f32>) -> f32 {
     return textureSampleLevel(field_volume_atlas, field_clamp_linear, atlas_uvw, 0.0).x * v.extinction_per_m;
 }
 
-fn field_extinction_detail(p: vec3<f32>, eroded: bool) -> f32 {
+fn field_extinction_of(p: vec3<f32>, density: u32) -> f32 {
     let h = field_altitude_m(p);
     var sigma_t = 0.0;
     for (var i = 0u; i < field.layer_count; i++) {
-        sigma_t += field_layer_extinction(i, p, h, eroded);
+        sigma_t += field_layer_extinction(i, p, h, density);
     }
     for (var i = 0u; i < field.volume_count; i++) {
         sigma_t += field_volume_extinction(field.volumes[i], p);
@@ -232,12 +255,18 @@ fn field_extinction_detail(p: vec3<f32>, eroded: bool) -> f32 {
 
 // Extinction sigma_t (m^-1) at world point p (m) at the field's time: CloudField::extinction_per_m.
 fn field_extinction(p: vec3<f32>) -> f32 {
-    return field_extinction_detail(p, true);
+    return field_extinction_of(p, FIELD_ERODED);
 }
 
 // The same without detail erosion: CloudField::coarse_extinction_per_m.
 fn field_extinction_coarse(p: vec3<f32>) -> f32 {
-    return field_extinction_detail(p, false);
+    return field_extinction_of(p, FIELD_COARSE);
+}
+
+// The eroded extinction's mean over the detail noise, light paths' density:
+// CloudField::mean_extinction_per_m.
+fn field_extinction_mean(p: vec3<f32>) -> f32 {
+    return field_extinction_of(p, FIELD_MEAN);
 }
 
 // The first stretch of the ray, within [0, t_max], inside the layers' altitude band.
@@ -276,12 +305,12 @@ fn field_volume_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
     return hull;
 }
 
-// Optical depth of the coarse (uneroded) field along p + t dir over t in [span.x, span.x + span.y],
+// Optical depth of the mean field (field_extinction_mean) along p + t dir over t in [span.x, span.x + span.y],
 // from n segments whose lengths grow by the factor span.z from one to the next (2: Schneider 2015's
 // doubling light samples, fine near p; 1: uniform), each sampled at a jittered point; the segments'
 // offsets are decorrelated from `jitter` and from each other by the golden ratio:
-// CloudField::coarse_optical_depth.
-fn field_optical_depth_coarse(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: u32, jitter: f32) -> f32 {
+// CloudField::mean_optical_depth.
+fn field_optical_depth_mean(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: u32, jitter: f32) -> f32 {
     var total = f32(n);
     if span.z != 1.0 {
         total = (pow(span.z, f32(n)) - 1.0) / (span.z - 1.0);
@@ -291,7 +320,7 @@ fn field_optical_depth_coarse(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: 
     var tau = 0.0;
     for (var k = 0u; k < n; k++) {
         let offset = fract(jitter + f32(k + 1u) * GOLDEN_RATIO_CONJUGATE);
-        tau += field_extinction_coarse(p + dir * (start + width * offset)) * width;
+        tau += field_extinction_mean(p + dir * (start + width * offset)) * width;
         start += width;
         width *= span.z;
     }

@@ -63,6 +63,8 @@ struct FieldUniform {
     volume_count: u32,
     hiheight_level_count: u32,
     atlas_bricks_xy: [u32; 2],
+    detail_fbm: Vec2,
+    reserved: Vec2,
     layers: [LayerUniform; MAX_LAYERS],
     volumes: [VolumeUniform; MAX_VOLUMES],
     hiheight_levels: [[u32; 4]; MAX_HIHEIGHT_LEVELS],
@@ -95,6 +97,10 @@ impl FieldUniform {
             volume_count: field.volumes.len() as u32,
             hiheight_level_count: levels.len() as u32,
             atlas_bricks_xy: [atlas.bricks.x, atlas.bricks.y],
+            detail_fbm: {
+                let noise = field.detail_statistics();
+                Vec2::new(noise.fbm_mean, noise.fbm_sd)
+            },
             ..FieldUniform::zeroed()
         };
         for (dst, [first, w, h]) in u.hiheight_levels.iter_mut().zip(levels) {
@@ -633,6 +639,8 @@ mod tests {
                 volume_count,
                 hiheight_level_count,
                 atlas_bricks_xy,
+                detail_fbm,
+                reserved,
                 layers,
                 volumes,
                 hiheight_levels,

@@ -4,6 +4,7 @@
 
 use super::noise::{hash_to_unit, lerp, pcg_hash, remap};
 use super::profile::TypeTable;
+use super::texture::{Texture8, unorm8};
 use crate::scene::CloudLayer;
 use glam::{Vec2, Vec3, Vec4};
 
@@ -113,8 +114,70 @@ pub fn apply_coverage(shape: f32, coverage: f32, type_coord: f32, f: f32) -> f32
 /// above 10 % of the layer, is subtracted through `remap(density, detail * erosion, 1, 0, 1)`.
 pub fn erode(density: f32, detail: Vec4, f: f32, erosion: f32) -> f32 {
     let fbm = detail.x * 0.625 + detail.y * 0.25 + detail.z * 0.125;
-    let modifier = lerp(fbm, 1.0 - fbm, (f * 10.0).clamp(0.0, 1.0));
-    remap(density, modifier * erosion, 1.0, 0.0, 1.0).clamp(0.0, 1.0)
+    remap(density, erosion_modifier(fbm, f) * erosion, 1.0, 0.0, 1.0).clamp(0.0, 1.0)
+}
+
+/// The detail fBm as [`erode`] subtracts it at height fraction `f`: wispy (the fBm) at the base,
+/// billowy (its complement) above 10 % of the layer.
+fn erosion_modifier(fbm: f32, f: f32) -> f32 {
+    lerp(fbm, 1.0 - fbm, (f * 10.0).clamp(0.0, 1.0))
+}
+
+/// The detail fBm's mean and standard deviation over a baked detail texture: what
+/// [`mean_erode`] needs of the noise (about 0.48 and 0.075 for every seed).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DetailStatistics {
+    /// Mean of the fBm [`erode`] reads.
+    pub fbm_mean: f32,
+    /// Its standard deviation.
+    pub fbm_sd: f32,
+}
+
+impl DetailStatistics {
+    /// The statistics of every texel of `detail`, the baked detail noise.
+    pub fn of(detail: &Texture8) -> DetailStatistics {
+        let fbm = |&t: &[u8; 4]| {
+            let v = unorm8(t);
+            (v.x * 0.625 + v.y * 0.25 + v.z * 0.125) as f64
+        };
+        let n = detail.texels.len() as f64;
+        let mean = detail.texels.iter().map(fbm).sum::<f64>() / n;
+        let variance = detail
+            .texels
+            .iter()
+            .map(|t| (fbm(t) - mean).powi(2))
+            .sum::<f64>()
+            / n;
+        DetailStatistics {
+            fbm_mean: mean as f32,
+            fbm_sd: variance.sqrt() as f32,
+        }
+    }
+}
+
+/// The expectation of [`erode`] over the detail noise: the density light paths read. The noise
+/// varies over tens of metres (its correlation falls to a half in about 90 m at the default
+/// 700 m period), finer than a light path's segments, so a path sees the eroded density's mean
+/// rather than the coarse density, its upper bound (Schneider 2015's cheap light samples). With
+/// the subtracted `x = modifier * erosion` taken as normal, `N(mu, s)` (the modifier is the fBm
+/// or its complement, or a blend `t` of the two whose spread is `|1 - 2t|` the fBm's), the mean of
+/// the ramp `(d - x)+` is `(d - mu) Phi(z) + s phi(z)`, `z = (d - mu) / s` (the normal partial
+/// expectation), divided by `1 - mu` as [`erode`]'s remap divides by `1 - x`: within 0.002 of
+/// the average over the baked noise at erosion 0.4 (the default), 0.01 at 0.8.
+pub fn mean_erode(density: f32, f: f32, erosion: f32, noise: DetailStatistics) -> f32 {
+    let blend = (f * 10.0).clamp(0.0, 1.0);
+    let mu = erosion_modifier(noise.fbm_mean, f) * erosion;
+    let s = ((1.0 - 2.0 * blend).abs() * noise.fbm_sd * erosion).max(1e-6);
+    let z = ((density - mu) / s).clamp(-8.0, 8.0);
+    let pdf = (-0.5 * z * z).exp() / (2.0 * std::f32::consts::PI).sqrt();
+    (((density - mu) * normal_cdf(z) + s * pdf) / (1.0 - mu)).clamp(0.0, 1.0)
+}
+
+/// The standard normal distribution function by Bowling et al. 2009's logistic approximation
+/// ("A logistic approximation to the cumulative normal distribution", J. Industrial Engineering
+/// and Management 2(1)): `1 / (1 + exp(-(0.07056 z^3 + 1.5976 z)))`, within 1.4e-4.
+fn normal_cdf(z: f32) -> f32 {
+    1.0 / (1.0 + (-(0.07056 * z * z * z + 1.5976 * z)).exp())
 }
 
 #[cfg(test)]
@@ -168,5 +231,30 @@ mod tests {
             assert!(erode(d, detail, 0.5, 0.35) <= d + 1e-6);
         }
         assert_eq!(erode(0.5, detail, 0.5, 0.0), 0.5);
+    }
+
+    #[test]
+    fn mean_erosion_is_the_eroded_density_averaged_over_the_noise() {
+        for seed in [3, 4000] {
+            let detail = crate::field::noise::NoiseKind::Detail.bake(seed);
+            let noise = DetailStatistics::of(&detail);
+            assert!((noise.fbm_mean - 0.48).abs() < 0.02, "{noise:?}");
+            for f in [0.0, 0.05, 0.5] {
+                for erosion in [0.0, 0.4, 0.8] {
+                    for i in 0..=20 {
+                        let d = i as f32 / 20.0;
+                        let eroded = |&t: &[u8; 4]| erode(d, unorm8(t), f, erosion);
+                        let average = detail.texels.iter().map(eroded).sum::<f32>()
+                            / detail.texels.len() as f32;
+                        let mean = mean_erode(d, f, erosion, noise);
+                        assert!(
+                            (mean - average).abs() < 0.004 + 0.01 * erosion,
+                            "seed {seed}, d {d}, f {f}, erosion {erosion}: {mean} against {average}"
+                        );
+                        assert!(mean <= d + 1e-6, "an upper bound remains one");
+                    }
+                }
+            }
+        }
     }
 }

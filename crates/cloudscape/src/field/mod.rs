@@ -24,7 +24,7 @@ pub mod voxel;
 pub mod weather;
 
 pub use brick::BrickGrid;
-pub use layer::LayerField;
+pub use layer::{DetailStatistics, LayerField};
 pub use noise::NoiseKind;
 pub use placed::{FileGrid, PlacedVolume};
 pub use reader::{CoarseFieldReader, CpuCoarseReader};
@@ -56,10 +56,11 @@ pub struct FieldError {
     pub message: String,
 }
 
-/// Whether detail noise erodes the density.
+/// Which density: eroded by the detail noise, its mean over the noise, or uneroded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Detail {
     Eroded,
+    Mean,
     Coarse,
 }
 
@@ -184,6 +185,7 @@ pub struct CloudField {
     base: NoiseSource,
     detail: NoiseSource,
     curl: NoiseSource,
+    detail_statistics: OnceLock<layer::DetailStatistics>,
 }
 
 impl CloudField {
@@ -235,6 +237,7 @@ impl CloudField {
             base: NoiseSource::new(NoiseKind::Base, seed),
             detail: NoiseSource::new(NoiseKind::Detail, seed),
             curl: NoiseSource::new(NoiseKind::Curl, seed),
+            detail_statistics: OnceLock::new(),
         })
     }
 
@@ -254,6 +257,17 @@ impl CloudField {
         self.base.bake();
     }
 
+    /// The detail noise's statistics that the mean density
+    /// ([`CloudField::mean_extinction_per_m`]) reads, from the baked detail noise (baked now if
+    /// it is not yet: 32^3 texels).
+    pub fn detail_statistics(&self) -> layer::DetailStatistics {
+        *self.detail_statistics.get_or_init(|| {
+            self.detail.bake();
+            let baked = self.detail.baked.get().expect("baked above");
+            layer::DetailStatistics::of(baked)
+        })
+    }
+
     /// Seed of the noise textures (the GPU generates them from it).
     pub fn noise_seed(&self) -> u32 {
         self.base.seed
@@ -271,13 +285,42 @@ impl CloudField {
         self.extinction(p, time_s, Detail::Coarse)
     }
 
+    /// The eroded extinction's mean over the detail noise ([`layer::mean_erode`]): the density
+    /// light paths read, as smooth as the coarse one and without its excess.
+    pub fn mean_extinction_per_m(&self, p: Vec3, time_s: f32) -> f32 {
+        self.extinction(p, time_s, Detail::Mean)
+    }
+
     /// Optical depth of the coarse field along `p + t dir` over `t` in `[start_m, start_m +
     /// length_m]`, from `n` segments whose lengths grow by `growth` from one to the next (2:
     /// Schneider 2015's doubling light samples, fine near `p`; 1: uniform), each sampled at a point
-    /// offset by `jitter` and decorrelated from the others by the golden ratio:
-    /// `field_optical_depth_coarse` in `field.wgsl`.
+    /// offset by `jitter` and decorrelated from the others by the golden ratio.
     pub fn coarse_optical_depth(
         &self,
+        ray: (Vec3, Vec3),
+        span: (f32, f32, f32),
+        samples: (u32, f32),
+        time_s: f32,
+    ) -> f32 {
+        self.optical_depth(Detail::Coarse, ray, span, samples, time_s)
+    }
+
+    /// [`CloudField::coarse_optical_depth`] through the mean density
+    /// ([`CloudField::mean_extinction_per_m`]): the light paths of the ray marcher, the light
+    /// volume and the cloud shadows, `field_optical_depth_mean` in `field.wgsl`.
+    pub fn mean_optical_depth(
+        &self,
+        ray: (Vec3, Vec3),
+        span: (f32, f32, f32),
+        samples: (u32, f32),
+        time_s: f32,
+    ) -> f32 {
+        self.optical_depth(Detail::Mean, ray, span, samples, time_s)
+    }
+
+    fn optical_depth(
+        &self,
+        detail: Detail,
         (p, dir): (Vec3, Vec3),
         (start_m, length_m, growth): (f32, f32, f32),
         (n, jitter): (u32, f32),
@@ -291,7 +334,7 @@ impl CloudField {
         let (mut width, mut start, mut tau) = (length_m / total, start_m, 0.0);
         for k in 0..n {
             let offset = (jitter + (k + 1) as f32 * GOLDEN_RATIO_CONJUGATE).fract();
-            tau += self.coarse_extinction_per_m(p + dir * (start + width * offset), time_s) * width;
+            tau += self.extinction(p + dir * (start + width * offset), time_s, detail) * width;
             start += width;
             width *= growth;
         }
@@ -313,16 +356,16 @@ impl CloudField {
         }
     }
 
-    /// Optical depth of the coarse field straight up from `p` to the top of the clouds at scene
+    /// Optical depth of the mean field straight up from `p` to the top of the clouds at scene
     /// time `time_s` (0 above them): the clouds over a point, from 32 uniform segments.
-    pub fn coarse_optical_depth_above(&self, p: Vec3, time_s: f32) -> f32 {
+    pub fn mean_optical_depth_above(&self, p: Vec3, time_s: f32) -> f32 {
         let (bottom_m, top_m, any) = self.cloud_heights();
         let start_m = (bottom_m - p.y).max(0.0);
         let length_m = top_m - p.y - start_m;
         if !any || length_m <= 0.0 {
             return 0.0;
         }
-        self.coarse_optical_depth((p, Vec3::Y), (start_m, length_m, 1.0), (32, 0.5), time_s)
+        self.mean_optical_depth((p, Vec3::Y), (start_m, length_m, 1.0), (32, 0.5), time_s)
     }
 
     fn extinction(&self, p: Vec3, time_s: f32, detail: Detail) -> f32 {
@@ -386,8 +429,14 @@ impl CloudField {
         if covered <= 0.0 {
             return 0.0;
         }
-        if detail == Detail::Coarse {
-            return covered.min(1.0) * w.z * layer.extinction_per_m;
+        match detail {
+            Detail::Coarse => return covered.min(1.0) * w.z * layer.extinction_per_m,
+            Detail::Mean => {
+                let noise = self.detail_statistics();
+                let mean = layer::mean_erode(covered.min(1.0), f, self.noise.detail_erosion, noise);
+                return mean * w.z * layer.extinction_per_m;
+            }
+            Detail::Eroded => {}
         }
         let curl = self
             .curl

@@ -16,9 +16,9 @@ pub enum ProbeFunction {
     Extinction = 0,
     /// `field_extinction_coarse(a.xyz)`: `CloudField::coarse_extinction_per_m`.
     CoarseExtinction = 1,
-    /// `field_optical_depth_coarse(a.xyz, b.xyz, span (0, a.w, growth b.w), 16 segments, jitter
-    /// 0.5)`: the coarse light paths of the march and the ground shadows.
-    CoarseOpticalDepth = 2,
+    /// `field_optical_depth_mean(a.xyz, b.xyz, span (0, a.w, growth b.w), 16 segments, jitter
+    /// 0.5)`: the light paths of the march, the light volume and the cloud shadows.
+    MeanOpticalDepth = 2,
     /// `frame_ray_direction(a.xy)`: `Frame::camera_ray`.
     CameraRay = 3,
     /// `frame_depth_distance(a.xy, depth a.z)`: `Frame::depth_distance_m` (1e30 for none).

@@ -20,7 +20,7 @@ fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>) ->
     switch f {
         case 0u: { return vec4<f32>(field_extinction(a.xyz)); }
         case 1u: { return vec4<f32>(field_extinction_coarse(a.xyz)); }
-        case 2u: { return vec4<f32>(field_optical_depth_coarse(a.xyz, b.xyz, vec3<f32>(0.0, a.w, b.w), 16u, 0.5)); }
+        case 2u: { return vec4<f32>(field_optical_depth_mean(a.xyz, b.xyz, vec3<f32>(0.0, a.w, b.w), 16u, 0.5)); }
         case 3u: { return vec4<f32>(frame_ray_direction(a.xy), 0.0); }
         case 4u: { return vec4<f32>(min(frame_depth_distance(a.xy, a.z), 1.0e30)); }
         case 5u: { return vec4<f32>(environment_aerial_perspective(a.xyz, a.w, b.yz, b.x), 0.0); }

@@ -1,4 +1,4 @@
-//! The ray marcher's light paths from a point in the clouds: the optical depth of the coarse field
+//! The ray marcher's light paths from a point in the clouds: the optical depth of the mean field
 //! toward the sun, to the top of the layers, and away from it, to where the path leaves them (the
 //! slab model's far side), each within [`super::SUN_PATH_M`] and sampled by doubling segments
 //! (Schneider 2015's cheap light samples). The CPU twins of `march_light.wgsl`, probed against it.
@@ -52,7 +52,7 @@ fn to_top_m(field: &CloudField, p: Vec3, dir: Vec3, top_m: f32) -> f32 {
         .map_or(-1.0, |(_, t1)| t1 as f32)
 }
 
-/// The coarse optical depth over `length_m` (None without layers: the longest path) clamped to
+/// The mean field's optical depth over `length_m` (None without layers: the longest path) clamped to
 /// [`SUN_PATH_M`].
 fn path_depth(
     field: &CloudField,
@@ -62,7 +62,7 @@ fn path_depth(
     time_s: f32,
 ) -> f32 {
     let length_m = length_m.map_or(SUN_PATH_M.1, |l| l.clamp(SUN_PATH_M.0, SUN_PATH_M.1));
-    field.coarse_optical_depth(ray, (0.0, length_m, 2.0), (steps, jitter), time_s)
+    field.mean_optical_depth(ray, (0.0, length_m, 2.0), (steps, jitter), time_s)
 }
 
 /// The march's light paths on the GPU (`march_light.wgsl`), the twin of this module.

@@ -66,7 +66,7 @@ fn march_sun_scattering(p: vec3<f32>, d: vec3<f32>, tau_sun: f32, jitter: f32, r
     return select(by_octaves, by_slab, march.lighting_model == 0u);
 }
 
-// The coarse optical depths (up, down) from p at altitude h to the top and the bottom of the
+// The mean field's optical depths (up, down) from p at altitude h to the top and the bottom of the
 // layer, each estimated from one sample halfway (500 m each way outside the layers).
 fn march_column(p: vec3<f32>, h: f32) -> vec2<f32> {
     let up = field_up(p);
@@ -76,8 +76,8 @@ fn march_column(p: vec3<f32>, h: f32) -> vec2<f32> {
         above = field.layer_top_m - h;
         below = h - field.layer_bottom_m;
     }
-    let tau_up = field_extinction_coarse(p + up * (0.5 * above)) * above;
-    let tau_down = field_extinction_coarse(p - up * (0.5 * below)) * below;
+    let tau_up = field_extinction_mean(p + up * (0.5 * above)) * above;
+    let tau_down = field_extinction_mean(p - up * (0.5 * below)) * below;
     return vec2<f32>(tau_up, tau_down);
 }
 

@@ -64,6 +64,18 @@ impl TemporalSettings {
     pub fn fresh_weight(&self) -> f32 {
         1.0 - (1.0 - self.blend_per_frame).powi((self.divisor * self.divisor) as i32)
     }
+
+    /// [`TemporalSettings::fresh_weight`] `history_frames` frames after the history began (or
+    /// after a leap of the camera): 1 until every pixel of a block has had a ray of its own, so
+    /// that each pixel's first own sample replaces what the history held (the interpolation of
+    /// the first frame's sparse rays, or a history reprojected from far away) instead of taking a
+    /// steady-state share of it; the weight of a running mean's first sample.
+    pub fn fresh_weight_after(&self, history_frames: u32) -> f32 {
+        match history_frames < self.divisor * self.divisor {
+            true => 1.0,
+            false => self.fresh_weight(),
+        }
+    }
 }
 
 /// The radical inverse of `index` in `base` (Halton 1964): a low-discrepancy sequence in [0, 1).
@@ -120,7 +132,14 @@ struct PreviousFrame {
     clip_from_world: Mat4,
     camera_m: Vec3,
     time_s: f32,
+    /// Frames resolved since the history began or the camera last leapt.
+    history_frames: u32,
 }
+
+/// A camera step longer than this fraction of [`TemporalSettings::cut_distance_m`] is a leap: the
+/// history is kept (it is not a cut), but most of it is reprojected from far away, so the
+/// fresh samples' weights start again as after a cut ([`TemporalSettings::fresh_weight_after`]).
+const LEAP_FRACTION: f32 = 0.1;
 
 /// The temporal resolve pass and its two full-resolution histories (ping-pong), each with the
 /// cloud distance its pixels show.
@@ -250,12 +269,16 @@ impl TemporalResolve {
         });
         let previous = if cut { None } else { self.previous };
         let s = &self.settings;
+        let leap = previous.is_some_and(|p| {
+            p.camera_m.distance(frame.camera_position_m) > LEAP_FRACTION * s.cut_distance_m
+        });
+        let history_frames = previous.map_or(0, |p| if leap { 0 } else { p.history_frames + 1 });
         let uniform = TemporalUniform {
             prev_clip_from_world: previous.map_or(clip_from_world, |p| p.clip_from_world),
             prev_camera_position_m: previous.map_or(frame.camera_position_m, |p| p.camera_m),
             history_valid: previous.is_some() as u32,
             wind_shift_m: wind_m_per_s * previous.map_or(0.0, |p| frame.time_s - p.time_s),
-            fresh_weight: s.fresh_weight(),
+            fresh_weight: s.fresh_weight_after(history_frames),
             clip_gamma: s.clip_gamma,
             distance_tolerance: s.distance_tolerance,
             reserved_0: 0,
@@ -267,6 +290,7 @@ impl TemporalResolve {
             clip_from_world,
             camera_m: frame.camera_position_m,
             time_s: frame.time_s,
+            history_frames,
         });
     }
 
@@ -295,9 +319,13 @@ pub static TEMPORAL_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module
 );
 
 /// Width (standard deviation, pixels) of the bump over which a new sample is blended into the
-/// history around its ray (`temporal_new_weight`): wide enough that no pixel lattice shows, narrow
-/// enough that a pixel between rays takes little of the interpolated estimate.
-pub const RAY_SIGMA_PX: f32 = 0.75;
+/// history around its ray (`temporal_new_weight`) where the history holds still: narrow, so that a
+/// pixel between rays takes little of the interpolated estimate, which blurs features thinner
+/// than the rays' spacing (a thin cloud on the horizon lost half its contrast at 0.75 px: every
+/// pixel's steady state mixed its own samples with interpolations across it). The pixel lattice
+/// does not show because every pixel meets its own ray once per divisor^2 frames, and from the
+/// start ([`TemporalSettings::fresh_weight_after`]).
+pub const RAY_SIGMA_PX: f32 = 0.4;
 
 /// The bump's width where the camera's step has moved the history [`CLIP_MOTION_PX`] or more by
 /// parallax since the previous frame: such a history is clipped, and the estimate between rays is
@@ -352,6 +380,17 @@ mod tests {
         assert_eq!(halton(3, 2), 0.75);
         assert!((halton(1, 3) - 1.0 / 3.0).abs() < 1e-7);
         assert!((halton(5, 3) - 7.0 / 9.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn first_own_samples_replace_the_history_then_blend() {
+        let s = TemporalSettings {
+            divisor: 4,
+            ..TemporalSettings::default()
+        };
+        assert!((0..16).all(|frames| s.fresh_weight_after(frames) == 1.0));
+        assert_eq!(s.fresh_weight_after(16), s.fresh_weight());
+        assert!(s.fresh_weight() < 0.6);
     }
 
     #[test]

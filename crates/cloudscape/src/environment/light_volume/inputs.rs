@@ -86,12 +86,12 @@ fn cell_inputs(
     for k in 0..8u32 {
         let corner = Vec3::new((k & 1) as f32, ((k >> 1) & 1) as f32, ((k >> 2) & 1) as f32);
         let offset = (corner * 2.0 - 1.0) * CELL_SAMPLE_OFFSET * cascade.cell_m;
-        sum += field.coarse_extinction_per_m(p + offset, light.time_s);
+        sum += field.mean_extinction_per_m(p + offset, light.time_s);
     }
     let extinction = optics.thinning * sum / 8.0;
     let sun = light.environment.env.sun.direction;
     let length_m = ((top_m - p.y) / sun.y.max(BEAM_MIN_SUN_Y)).clamp(0.0, BEAM_PATH_MAX_M);
-    let tau = field.coarse_optical_depth(
+    let tau = field.mean_optical_depth(
         (p, sun),
         (0.0, length_m, BEAM_GROWTH),
         (beam_steps, 0.5),

@@ -46,8 +46,8 @@ fn light_volume_centre(c: vec3<u32>, k: u32) -> vec3<f32> {
     return v.cascade_min_m[k].xyz + (vec3<f32>(c) + 0.5) * v.cascade_cell_m[k].xyz;
 }
 
-// Cell inputs (inputs::cell_inputs): the mean coarse extinction at eight points, scaled, and the
-// sun's irradiance through the air times exp(-tau') of the coarse field toward the sun.
+// Cell inputs (inputs::cell_inputs): the mean field's extinction averaged over eight points, scaled,
+// and the sun's irradiance through the air times exp(-tau') of the mean field toward the sun.
 @compute @workgroup_size(8, 8)
 fn light_volume_cells(@builtin(global_invocation_id) id: vec3<u32>) {
     light_volume_cell_inputs(id.xy);
@@ -75,14 +75,14 @@ fn light_volume_cell_inputs(id: vec2<u32>) {
     var sum = 0.0;
     for (var s = 0u; s < 8u; s++) {
         let corner = vec3<f32>(f32(s & 1u), f32((s >> 1u) & 1u), f32((s >> 2u) & 1u));
-        sum += field_extinction_coarse(p + (corner * 2.0 - 1.0) * LIGHT_VOLUME_CELL_SAMPLE_OFFSET * cell_m);
+        sum += field_extinction_mean(p + (corner * 2.0 - 1.0) * LIGHT_VOLUME_CELL_SAMPLE_OFFSET * cell_m);
     }
     let thinning = v.optics.z;
     let extinction = thinning * sum / 8.0;
     let sun = environment.sun_direction;
     let top_m = v.cascade_min_m[k].y + cell_m.y * f32(v.cells.y);
     let length_m = clamp((top_m - p.y) / max(sun.y, LIGHT_VOLUME_BEAM_MIN_SUN_Y), 0.0, LIGHT_VOLUME_BEAM_PATH_MAX_M);
-    let tau = field_optical_depth_coarse(p, sun, vec3<f32>(0.0, length_m, LIGHT_VOLUME_BEAM_GROWTH), v.beam_steps, 0.5);
+    let tau = field_optical_depth_mean(p, sun, vec3<f32>(0.0, length_m, LIGHT_VOLUME_BEAM_GROWTH), v.beam_steps, 0.5);
     let beam = environment_sun_irradiance(p) * exp(-thinning * tau);
     var cell = vec4<f32>(beam, extinction);
     if v.enabled == 0u {

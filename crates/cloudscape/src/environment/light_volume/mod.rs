@@ -14,9 +14,9 @@
 //! cells so that it stays put while the camera moves within one. A point reads the finest cascade
 //! it lies in.
 //!
-//! **Per cell** ([`inputs`]): the δ-scaled extinction, the mean of the coarse field at eight points
+//! **Per cell** ([`inputs`]): the δ-scaled extinction, the mean field (`CloudField::mean_extinction_per_m`) at eight points
 //! of the cell, and the scaled sun beam's irradiance, the sun's irradiance there through the air
-//! times `exp(-tau')` of the coarse field toward the sun. **Solve**: line relaxation, warm-started
+//! times `exp(-tau')` of the mean field toward the sun. **Solve**: line relaxation, warm-started
 //! from the last frame's solution when the grid has not moved. **Read**: the march scatters
 //! `I0 + g w . I1` toward the eye along `w` (`environment_light_volume_diffuse`): per cell the
 //! volume stores `I0` (RGB) and the current `J = I1 / 3` over `I0` (of luminance).
@@ -93,7 +93,7 @@ pub struct LightVolumeSettings {
     pub sweeps: u32,
     /// Sweeps per frame once warm.
     pub warm_sweeps: u32,
-    /// Samples of the coarse field toward the sun per cell.
+    /// Samples of the mean field toward the sun per cell.
     pub beam_steps: u32,
 }
 

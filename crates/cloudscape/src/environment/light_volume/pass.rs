@@ -29,7 +29,7 @@ const ENTRIES: [&str; 8] = [
 ];
 
 /// Slices the cells' rows are updated in on warm frames, one a frame: a warm frame recomputes the
-/// inputs (the coarse field's extinction, the sun's beam through it) of a quarter of the cells.
+/// inputs (the mean field's extinction, the sun's beam through it) of a quarter of the cells.
 pub const CELL_SLICES: u32 = 4;
 
 /// Texels a row of the table's staging buffer is padded to: wgpu copies rows of 256 bytes
