@@ -100,7 +100,7 @@ pub(crate) fn sky_ambient_light(
     (eye_m, exposure): ([f32; 3], f32),
 ) -> AmbientLight {
     let p = glam::Vec3::from_array(eye_m);
-    let tau_above = clouds.map_or(0.0, |(f, time_s)| f.mean_optical_depth_above(p, time_s));
+    let tau_above = clouds.map_or(0.0, |(f, time_s)| f.coarse_optical_depth_above(p, time_s));
     let asymmetry = PhaseLobes::from_scene(&scene.phase).mean_cosine();
     let env = Environment::new(&Sky::from_scene(scene), sun);
     let radiance = env.diffuse_radiance_up(p, tau_above, asymmetry) / exposure;
@@ -169,7 +169,7 @@ mod tests {
         let field = CloudField::new(&doc.scene, &doc.resolve_path("")).expect("the field builds");
         let lux = 1e5;
         let sun = sun(lux, 1.0);
-        let tau = field.mean_optical_depth_above(glam::Vec3::from_array(EYE.0), 0.0);
+        let tau = field.coarse_optical_depth_above(glam::Vec3::from_array(EYE.0), 0.0);
         let clear = radiance(&sky_ambient_light(&doc.scene, &sun, None, EYE));
         let deck = radiance(&sky_ambient_light(
             &doc.scene,

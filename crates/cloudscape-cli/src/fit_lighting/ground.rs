@@ -97,7 +97,7 @@ pub fn ground_samples(
         .collect())
 }
 
-/// The mean field's optical depth along `dir` (unit, upward) from ground point `g` across the
+/// The coarse field's optical depth along `dir` (unit, upward) from ground point `g` across the
 /// layers' altitudes `(bottom_m, top_m)`.
 fn optical_depth_along(
     field: &CloudField,
@@ -106,7 +106,7 @@ fn optical_depth_along(
     (bottom_m, top_m): (f32, f32),
 ) -> f32 {
     let rise = dir.y.max(0.02);
-    field.mean_optical_depth(
+    field.coarse_optical_depth(
         (g, dir),
         (bottom_m / rise, (top_m - bottom_m) / rise, 1.0),
         (LINE_STEPS, 0.5),

@@ -1,4 +1,4 @@
-// Builds the clouds' shared light-space map (shadow/mod.rs): per texel, the mean optical depth
+// Builds the clouds' shared light-space map (shadow/mod.rs): per texel, the coarse optical depth
 // from four checkpoint heights to the top of the clouds, along the sun (layer 0, binding 0) and
 // straight up (layer 1, binding 1). ShadowParams::column.
 
@@ -23,7 +23,7 @@ fn shadow_column(g: vec2<f32>, rise: vec3<f32>) -> vec4<f32> {
         let y0 = shadow_checkpoint_y(k);
         let y1 = shadow_checkpoint_y(k + 1u);
         let span = vec3<f32>(y0 * length_per_m, (y1 - y0) * length_per_m, 1.0);
-        above += field_optical_depth_mean(base, dir, span, environment.shadow.steps_per_checkpoint, 0.5);
+        above += field_optical_depth_coarse(base, dir, span, environment.shadow.steps_per_checkpoint, 0.5);
         out[k] = above;
     }
     return vec4<f32>(out[0], out[1], out[2], out[3]);

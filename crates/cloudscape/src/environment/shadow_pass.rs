@@ -1,4 +1,4 @@
-//! The cloud shadow map's pass: every texel's two columns through the mean field, each frame.
+//! The cloud shadow map's pass: every texel's two columns through the coarse field, each frame.
 
 use super::{EnvironmentGpu, EnvironmentTable, TablePass};
 use crate::gpu::{GpuContext, PassTimer};

@@ -305,12 +305,22 @@ fn field_volume_interval(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> vec2<f32> {
     return hull;
 }
 
-// Optical depth of the mean field (field_extinction_mean) along p + t dir over t in [span.x, span.x + span.y],
-// from n segments whose lengths grow by the factor span.z from one to the next (2: Schneider 2015's
-// doubling light samples, fine near p; 1: uniform), each sampled at a jittered point; the segments'
-// offsets are decorrelated from `jitter` and from each other by the golden ratio:
-// CloudField::mean_optical_depth.
+// Optical depth of the mean field (field_extinction_mean) along p + t dir over t in [span.x,
+// span.x + span.y]: CloudField::mean_optical_depth.
 fn field_optical_depth_mean(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: u32, jitter: f32) -> f32 {
+    return field_optical_depth_of(p, dir, span, n, jitter, FIELD_MEAN);
+}
+
+// The same through the coarse field: CloudField::coarse_optical_depth.
+fn field_optical_depth_coarse(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: u32, jitter: f32) -> f32 {
+    return field_optical_depth_of(p, dir, span, n, jitter, FIELD_COARSE);
+}
+
+// Optical depth of `density` along p + t dir over t in [span.x, span.x + span.y], from n segments
+// whose lengths grow by the factor span.z from one to the next (2: Schneider 2015's doubling light
+// samples, fine near p; 1: uniform), each sampled at a jittered point; the segments' offsets are
+// decorrelated from `jitter` and from each other by the golden ratio.
+fn field_optical_depth_of(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: u32, jitter: f32, density: u32) -> f32 {
     var total = f32(n);
     if span.z != 1.0 {
         total = (pow(span.z, f32(n)) - 1.0) / (span.z - 1.0);
@@ -320,7 +330,7 @@ fn field_optical_depth_mean(p: vec3<f32>, dir: vec3<f32>, span: vec3<f32>, n: u3
     var tau = 0.0;
     for (var k = 0u; k < n; k++) {
         let offset = fract(jitter + f32(k + 1u) * GOLDEN_RATIO_CONJUGATE);
-        tau += field_extinction_mean(p + dir * (start + width * offset)) * width;
+        tau += field_extinction_of(p + dir * (start + width * offset), density) * width;
         start += width;
         width *= span.z;
     }

@@ -294,7 +294,8 @@ impl CloudField {
     /// Optical depth of the coarse field along `p + t dir` over `t` in `[start_m, start_m +
     /// length_m]`, from `n` segments whose lengths grow by `growth` from one to the next (2:
     /// Schneider 2015's doubling light samples, fine near `p`; 1: uniform), each sampled at a point
-    /// offset by `jitter` and decorrelated from the others by the golden ratio.
+    /// offset by `jitter` and decorrelated from the others by the golden ratio: the cloud shadow
+    /// map's columns, `field_optical_depth_coarse` in `field.wgsl`.
     pub fn coarse_optical_depth(
         &self,
         ray: (Vec3, Vec3),
@@ -306,8 +307,8 @@ impl CloudField {
     }
 
     /// [`CloudField::coarse_optical_depth`] through the mean density
-    /// ([`CloudField::mean_extinction_per_m`]): the light paths of the ray marcher, the light
-    /// volume and the cloud shadows, `field_optical_depth_mean` in `field.wgsl`.
+    /// ([`CloudField::mean_extinction_per_m`]): the light paths of the ray marcher and the light
+    /// volume, `field_optical_depth_mean` in `field.wgsl`.
     pub fn mean_optical_depth(
         &self,
         ray: (Vec3, Vec3),
@@ -356,16 +357,17 @@ impl CloudField {
         }
     }
 
-    /// Optical depth of the mean field straight up from `p` to the top of the clouds at scene
-    /// time `time_s` (0 above them): the clouds over a point, from 32 uniform segments.
-    pub fn mean_optical_depth_above(&self, p: Vec3, time_s: f32) -> f32 {
+    /// Optical depth of the coarse field straight up from `p` to the top of the clouds at scene
+    /// time `time_s` (0 above them): the clouds over a point, from 32 uniform segments, as the
+    /// cloud shadow map's sky column reads it.
+    pub fn coarse_optical_depth_above(&self, p: Vec3, time_s: f32) -> f32 {
         let (bottom_m, top_m, any) = self.cloud_heights();
         let start_m = (bottom_m - p.y).max(0.0);
         let length_m = top_m - p.y - start_m;
         if !any || length_m <= 0.0 {
             return 0.0;
         }
-        self.mean_optical_depth((p, Vec3::Y), (start_m, length_m, 1.0), (32, 0.5), time_s)
+        self.coarse_optical_depth((p, Vec3::Y), (start_m, length_m, 1.0), (32, 0.5), time_s)
     }
 
     fn extinction(&self, p: Vec3, time_s: f32, detail: Detail) -> f32 {

@@ -17,7 +17,7 @@ pub enum ProbeFunction {
     /// `field_extinction_coarse(a.xyz)`: `CloudField::coarse_extinction_per_m`.
     CoarseExtinction = 1,
     /// `field_optical_depth_mean(a.xyz, b.xyz, span (0, a.w, growth b.w), 16 segments, jitter
-    /// 0.5)`: the light paths of the march, the light volume and the cloud shadows.
+    /// 0.5)`: the light paths of the march and the light volume.
     MeanOpticalDepth = 2,
     /// `frame_ray_direction(a.xy)`: `Frame::camera_ray`.
     CameraRay = 3,

@@ -1,4 +1,4 @@
-//! The clouds' shared light-space transmittance map: one cheap pass over the mean field per frame
+//! The clouds' shared light-space transmittance map: one cheap pass over the coarse field per frame
 //! that every technique's ground, the air's light shafts and a host's geometry are shadowed by.
 //!
 //! The map lies on the world's ground plane (`y = 0`), centred under the viewpoint, out to the
@@ -7,7 +7,7 @@
 //! under the eye, growing outward). Each texel holds two columns through the clouds from its
 //! ground point: along the sun (layer 0, projected so that the point at height `y` is
 //! `g + (sun.xz / sun.y) y`) and straight up (layer 1, for the sky's light). A column stores the
-//! mean optical depth from four checkpoint heights (`bottom + 0, 1/4, 1/2, 3/4` of the clouds'
+//! coarse optical depth from four checkpoint heights (`bottom + 0, 1/4, 1/2, 3/4` of the clouds'
 //! height span) to the top; between checkpoints the depth is linear in height. A point is shadowed
 //! by reading the column through it: `environment_cloud_sun_optical_depth(p)` in
 //! `environment.wgsl`, which [`CloudShadowMap::optical_depth`] specifies, through
@@ -41,7 +41,7 @@ pub struct ShadowParams {
     pub sun_y: f32,
     /// Whether there are clouds at all (the map reads zero when not).
     pub enabled: bool,
-    /// Samples of the mean field between two checkpoints.
+    /// Samples of the coarse field between two checkpoints.
     pub steps_per_checkpoint: u32,
 }
 
@@ -118,7 +118,7 @@ impl ShadowParams {
         self.bottom_y_m + (self.top_y_m - self.bottom_y_m) * k as f32 / CHECKPOINTS as f32
     }
 
-    /// The column of `layer` from ground point `g`: the mean optical depth from each
+    /// The column of `layer` from ground point `g`: the coarse optical depth from each
     /// checkpoint to the top, at scene time `time_s` (`shadow_build` in `cloud_shadow.wgsl`).
     pub fn column(
         &self,
@@ -136,7 +136,7 @@ impl ShadowParams {
             let (y0, y1) = (self.checkpoint_y(k), self.checkpoint_y(k + 1));
             let span = (y0 * length, (y1 - y0) * length, 1.0);
             let samples = (self.steps_per_checkpoint, 0.5);
-            above += field.mean_optical_depth((base, dir), span, samples, time_s);
+            above += field.coarse_optical_depth((base, dir), span, samples, time_s);
             out[k] = above;
         }
         out
