@@ -120,7 +120,12 @@ pub fn erode(density: f32, detail: Vec4, f: f32, erosion: f32) -> f32 {
 /// The detail fBm as [`erode`] subtracts it at height fraction `f`: wispy (the fBm) at the base,
 /// billowy (its complement) above 10 % of the layer.
 fn erosion_modifier(fbm: f32, f: f32) -> f32 {
-    lerp(fbm, 1.0 - fbm, (f * 10.0).clamp(0.0, 1.0))
+    lerp(fbm, 1.0 - fbm, billow_blend(f))
+}
+
+/// How far [`erosion_modifier`] has turned from the fBm to its complement at height fraction `f`.
+fn billow_blend(f: f32) -> f32 {
+    (f * 10.0).clamp(0.0, 1.0)
 }
 
 /// The detail fBm's mean and standard deviation over a baked detail texture: what
@@ -165,7 +170,7 @@ impl DetailStatistics {
 /// expectation), divided by `1 - mu` as [`erode`]'s remap divides by `1 - x`: within 0.002 of
 /// the average over the baked noise at erosion 0.4 (the default), 0.01 at 0.8.
 pub fn mean_erode(density: f32, f: f32, erosion: f32, noise: DetailStatistics) -> f32 {
-    let blend = (f * 10.0).clamp(0.0, 1.0);
+    let blend = billow_blend(f);
     let mu = erosion_modifier(noise.fbm_mean, f) * erosion;
     let s = ((1.0 - 2.0 * blend).abs() * noise.fbm_sd * erosion).max(1e-6);
     let z = ((density - mu) / s).clamp(-8.0, 8.0);
