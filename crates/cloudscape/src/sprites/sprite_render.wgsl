@@ -55,9 +55,10 @@ struct Varying {
     @builtin(position) clip: vec4<f32>,
     @location(0) uv: vec2<f32>,                 // on the puff sheet
     @location(1) diffuse: vec3<f32>,            // ambient + directional radiance
-    @location(2) single: vec3<f32>,             // single-scattered sun (silver lining)
+    @location(2) single: vec3<f32>,             // albedo x the sun's irradiance reaching the sprite (Wang: its group's)
+    @location(9) tau_sun: f32,                  // volume: the cloud shadow map's optical depth toward the sun
     @location(7) thin_only: f32,                // 1: the single-scattered sun lights only thin parts
-    @location(8) cos_sun: f32,                  // between the view ray and the direction to the sun
+    @location(8) position_m: vec3<f32>,         // world position (the view ray's direction, per fragment)
     @location(3) opacity: f32,                  // fades and the level's opacity
     @location(6) optical_depth: f32,            // the sprite's, through its densest column
     @location(4) distance_m: f32,
@@ -127,10 +128,8 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     let level = sprite_level(c.colors, heights, clamp((p.y - c.bottom_y_m) / max(c.height_m, 1.0), 0.0, 1.0));
     let maxima = sprite_max_colours(p);
     let view_dir = normalize(p - view.eye_m);
-    let cos_sun = dot(view_dir, environment_sun_direction());
-    let phase = phase_eval(settings.phase_lobes, cos_sun);
     let wang_diffuse = level.rgb * maxima[0] + s.directional * maxima[1];
-    let wang_single = settings.albedo * environment_sun_irradiance(p) * s.sun_transmittance * phase;
+    let wang_single = settings.albedo * environment_sun_irradiance(p) * s.sun_transmittance;
     // Field sprites in a frame with a light volume: lit as the ray marcher lights a sample of
     // the field halfway between the sprite's centre and this corner (so a sprite shades from its
     // sunlit to its shadowed side): the volume's diffuse light, and the sun's beam (single
@@ -138,8 +137,7 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     let q = mix(centre, p, 0.5);
     let volume = s.layer < 4u && settings.lit_by_volume == 1u && environment_has_light_volume();
     let tau_sun = environment_cloud_sun_optical_depth(q);
-    let slab = SlabModel(settings.phase_lobes, settings.slab_params);
-    let volume_single = settings.albedo * environment_sun_irradiance(q) * slab_beam_scattering(slab, cos_sun, tau_sun);
+    let volume_single = settings.albedo * environment_sun_irradiance(q);
     let volume_diffuse = settings.albedo * environment_light_volume_diffuse(q, -view_dir);
 
     var out: Varying;
@@ -149,7 +147,8 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     out.diffuse = select(wang_diffuse, volume_diffuse, volume);
     out.single = select(wang_single, volume_single, volume);
     out.thin_only = select(1.0, 0.0, volume);
-    out.cos_sun = cos_sun;
+    out.tau_sun = tau_sun;
+    out.position_m = p;
     out.opacity = level.a * through * edge_on * far;
     out.optical_depth = s.optical_depth;
     out.distance_m = length(p - view.eye_m);
@@ -157,19 +156,31 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     return out;
 }
 
-// The sun's beam that a slab of optical depth `tau` scatters toward the eye, per unit of the beam's
-// scattering, once the slab's own matter has dimmed it on both legs: the sun enters the side
-// facing it, so a point at depth t from the eye's side is reached through
-// s(t) = tau (1 + c) / 2 - c t of the slab (the far side's depth when the sun is behind it, c = 1;
-// t when it is behind the eye, c = -1; half the slab from the side), and the light it scatters
-// leaves through t: the integral of exp(-t - s(t)) over [0, tau],
-// exp(-tau (1 + c) / 2) (1 - exp(-tau (1 - c))) / (1 - c). Thin slabs give tau, as
-// 1 - exp(-tau) does; a thick one against the sun only tau exp(-tau) (single scattering in a
-// homogeneous slab, Chandrasekhar 1960, ch. I).
-fn sprite_beam_weight(tau: f32, c: f32) -> f32 {
+// The sun's beam that a sprite of optical depth `tau` scatters toward the eye, per unit of the
+// beam's irradiance times the albedo, after `tau_sun` of cloud toward the sun outside the sprite:
+// the ray marcher's per-sample beam (single scattering and the forward peak, slab_beam_scattering)
+// integrated through the sprite. The sun enters the side facing it, so a point at depth t from the
+// eye's side is reached through s(t) = tau (1 + c) / 2 - c t of the sprite (the far side's depth
+// when the sun is behind it, c = 1; t when it is behind the eye, c = -1; half the sprite from the
+// side), and the light it scatters leaves through t. The single-scattering part is closed-form: the
+// integral of exp(-t - s(t)) over [0, tau], exp(-tau (1 + c) / 2) (1 - exp(-tau (1 - c))) / (1 - c)
+// (a homogeneous slab, Chandrasekhar 1960, ch. I: tau for a thin one, tau exp(-tau) for a thick
+// one against the sun); the forward peak's beam, which a thick sprite against the sun keeps where
+// extinction alone would lose it, by 3-point Gauss-Legendre quadrature over t.
+fn sprite_beam(tau: f32, c: f32, tau_sun: f32) -> f32 {
+    let slab = SlabModel(settings.phase_lobes, settings.slab_params);
     let k = 1.0 - c;
     let inner = select((1.0 - exp(-tau * k)) / max(k, 1e-6), tau, k < 1e-4);
-    return exp(-0.5 * tau * (1.0 + c)) * inner;
+    let single = phase_eval(settings.phase_lobes, c) * exp(-tau_sun - 0.5 * tau * (1.0 + c)) * inner;
+    let nodes = array<f32, 3>(0.5 - 0.5 * sqrt(0.6), 0.5, 0.5 + 0.5 * sqrt(0.6));
+    let weights = array<f32, 3>(5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0);
+    var peak = 0.0;
+    for (var i = 0u; i < 3u; i++) {
+        let t = tau * nodes[i];
+        let through = tau_sun + 0.5 * tau * (1.0 + c) - c * t;
+        peak += weights[i] * exp(-t) * slab_peak_beam(slab, c, through);
+    }
+    return single + tau * peak;
 }
 
 @fragment
@@ -185,9 +196,13 @@ fn fs_sprite(in: Varying) -> SpriteTargets {
     let alpha = (1.0 - exp(-tau)) * visible;
     // Wang's model: thin parts of a puff scatter the direct sun once toward the eye (premultiplied,
     // E p tau ~ E p alpha for thin matter), its thick core's light is the diffuse term's. Lit from
-    // physics: the beam dimmed within the sprite on its way in and out.
+    // physics: the sun's beam through the sprite, as the ray marcher's samples scatter it.
     let thin = alpha * (1.0 - cover) * (1.0 - cover);
-    let beam = sprite_beam_weight(tau, in.cos_sun) * visible;
-    let radiance = alpha * in.diffuse + mix(beam, thin, in.thin_only) * in.single;
+    // The phase function peaks sharply toward the sun: the angle is the fragment's own, not
+    // interpolated across a quad that may span tens of degrees.
+    let cos_sun = dot(normalize(in.position_m - view.eye_m), environment_sun_direction());
+    let beam = sprite_beam(tau, cos_sun, in.tau_sun) * visible;
+    let silver = thin * phase_eval(settings.phase_lobes, cos_sun);
+    let radiance = alpha * in.diffuse + mix(beam, silver, in.thin_only) * in.single;
     return sprite_targets(radiance, alpha, in.distance_m);
 }
