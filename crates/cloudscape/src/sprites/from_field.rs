@@ -48,6 +48,11 @@ const MAX_CANDIDATES: u32 = 600;
 const BOX_COLUMNS: i32 = 3;
 /// Height fractions at which the band of a type's profile is searched.
 const BAND_STEPS: u32 = 32;
+/// Heights at which a sheet's column is read under each of its sprites: a sheet's sprite stands for
+/// the whole column of the deck at its place, so its opacity follows the column's mean extinction,
+/// not the extinction at the candidate's own height (in a thin deck that jumps from the profile's
+/// peak to nothing across the band, and broke the thin stratus into streaks of blue sky).
+const SHEET_COLUMN_READS: usize = 8;
 
 /// Where and how far field clouds are made.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -125,7 +130,7 @@ impl FieldTiling {
             .flatten()
             .flat_map(|d| {
                 let wind = layer_drift_m(&field.layers[d.layer as usize], self.time_s);
-                d.points_m.iter().map(move |&p| p + wind)
+                d.read_points_m().iter().map(move |&p| p + wind)
             })
             .collect();
         let extinctions = reader.coarse_extinctions_per_m(&points);
@@ -135,7 +140,7 @@ impl FieldTiling {
         let mut read = Vec::with_capacity(drafts.len());
         for draft in drafts {
             read.push(draft.map(|d| {
-                let span = at..at + d.points_m.len();
+                let span = at..at + d.read_points_m().len();
                 at = span.end;
                 (d, span)
             }));
@@ -180,10 +185,23 @@ impl FieldTiling {
                 Vec3::new(xz.x, bottom + u(2) * (top - bottom), xz.y)
             })
             .collect();
-        let points_m: Vec<Vec3> = cull(&candidates, radius)
-            .into_iter()
+        let kept = cull(&candidates, radius);
+        let points_m: Vec<Vec3> = kept
+            .iter()
             .map(|c| world_point(field, Vec2::new(c.x, c.z), c.y))
             .collect();
+        let column_reads_m = match recipe.sheet {
+            true => kept
+                .iter()
+                .flat_map(|c| {
+                    (0..SHEET_COLUMN_READS).map(move |i| {
+                        let share = (i as f32 + 0.5) / SHEET_COLUMN_READS as f32;
+                        world_point(field, Vec2::new(c.x, c.z), bottom + share * (top - bottom))
+                    })
+                })
+                .collect(),
+            false => Vec::new(),
+        };
         let cell_m3 = self.tile_m * self.tile_m * (top - bottom) / points_m.len().max(1) as f32;
         Some(TileDraft {
             cloud_type,
@@ -193,6 +211,7 @@ impl FieldTiling {
             layer: key.layer,
             tile_m: self.tile_m,
             points_m,
+            column_reads_m,
             cell_m3,
         })
     }
@@ -243,6 +262,9 @@ pub struct TileDraft {
     tile_m: f32,
     /// The candidates' centres after the cull, in the layer's wind frame at time 0, m.
     points_m: Vec<Vec3>,
+    /// A sheet's: [`SHEET_COLUMN_READS`] points across the band under each candidate, where its
+    /// extinction is read (empty for other clouds, read at the candidates), m.
+    column_reads_m: Vec<Vec3>,
     /// The volume of cloud each candidate stands for: the band over the tile, shared out, m^3.
     cell_m3: f32,
 }
@@ -253,8 +275,17 @@ impl TileDraft {
         self.points_m.len()
     }
 
-    /// The cloud of the candidates where the field is cloudy (`extinctions_per_m`, one per
-    /// candidate, of a layer whose densest extinction is `layer_extinction_per_m`), each sprite
+    /// Where the field is read for the candidates: each candidate's column for a sheet, else the
+    /// candidates themselves.
+    fn read_points_m(&self) -> &[Vec3] {
+        match self.column_reads_m.is_empty() {
+            true => &self.points_m,
+            false => &self.column_reads_m,
+        }
+    }
+
+    /// The cloud of the candidates where the field is cloudy (`extinctions_per_m`, read at
+    /// [`Self::read_points_m`], of a layer whose densest extinction is `layer_extinction_per_m`), each sprite
     /// wide enough to overlap its neighbours and as opaque as the matter of its cell (puffs of
     /// mean cover `cover`); None where the tile is clear.
     fn finish(
@@ -264,13 +295,17 @@ impl TileDraft {
         cover: f32,
     ) -> Option<SpriteCloud> {
         let recipe = self.cloud_type.recipe();
+        let reads = extinctions_per_m.len() / self.points_m.len().max(1);
+        let means = extinctions_per_m
+            .chunks(reads.max(1))
+            .map(|column| column.iter().sum::<f32>() / column.len() as f32);
         let present: Vec<(usize, Vec3, f32)> = self
             .points_m
             .iter()
-            .zip(extinctions_per_m)
+            .zip(means)
             .enumerate()
-            .filter(|(_, (_, e))| **e >= MIN_DENSITY * layer_extinction_per_m)
-            .map(|(k, (&p, &e))| (k, p, e))
+            .filter(|(_, (_, e))| *e >= MIN_DENSITY * layer_extinction_per_m)
+            .map(|(k, (&p, e))| (k, p, e))
             .collect();
         let least_width_m = self.least_width_m(&recipe, present.len());
         let sprites: Vec<_> = present
@@ -454,7 +489,7 @@ mod tests {
     /// centre times the volume each candidate stands for), and a sheet's sprites are wide enough
     /// to overlap into a veil.
     #[test]
-    fn field_sprites_hold_the_matter_of_their_cells_and_sheets_overlap() {
+    fn field_sprites_hold_the_matter_of_their_cells_and_sheets_overlap_over_their_columns() {
         let mut scene = Scene::default();
         scene.layers[0].coverage = 0.6;
         let f = CloudField::new(&scene, Path::new(".")).unwrap();
@@ -512,5 +547,32 @@ mod tests {
             cloud.sprites.iter().all(|s| s.size_m.x >= 3.99 * spacing),
             "{spacing}"
         );
+
+        // A sheet's sprite holds the matter of the deck's whole column at its place (integrated
+        // finely here), whatever height its candidate was drawn at.
+        let draft = TILING.draft(&f, key).unwrap();
+        let mut columns = 0;
+        for s in cloud.sprites.iter().filter(|s| s.opacity < 1.0) {
+            let p = cloud.center_m + s.offset_m;
+            let steps = 256;
+            let column: f32 = (0..steps)
+                .map(|i| {
+                    let y = 700.0 + (i as f32 + 0.5) / steps as f32 * 400.0;
+                    let at = world_point(&f, Vec2::new(p.x, p.z), y);
+                    f.coarse_extinction_per_m(at, 0.0)
+                })
+                .sum::<f32>()
+                * 400.0
+                / steps as f32;
+            let matter = column * TILING.tile_m * TILING.tile_m / draft.candidates() as f32;
+            let held = s.opacity
+                * MAX_SPRITE_OPTICAL_DEPTH
+                * super::super::textures::mean_cover()
+                * s.size_m.x
+                * s.size_m.y;
+            assert!((held - matter).abs() <= 0.08 * matter, "{held} vs {matter}");
+            columns += 1;
+        }
+        assert!(columns > 10, "{columns}");
     }
 }

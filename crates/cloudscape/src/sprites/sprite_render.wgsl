@@ -90,6 +90,14 @@ fn sprite_max_colours(p: vec3<f32>) -> array<vec3<f32>, 2> {
     );
 }
 
+// The mean depth of first scattering along a chord of optical depth `tau` through uniform matter,
+// as a share of the chord: the mean of t over [0, tau] weighted by exp(-t), over tau,
+// 1 / tau - e^-tau / (1 - e^-tau) (1/2 for thin matter, 1 / tau for thick).
+fn sprite_scattering_depth(tau: f32) -> f32 {
+    let e = exp(-tau);
+    return select(1.0 / tau - e / (1.0 - e), 0.5, tau < 1e-3);
+}
+
 @vertex
 fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> Varying {
     let s = sprites[order[i]];
@@ -133,12 +141,19 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     // Field sprites in a frame with a light volume: lit as the ray marcher lights a sample of
     // the field halfway between the sprite's centre and this corner (so a sprite shades from its
     // sunlit to its shadowed side): the volume's diffuse light, and the sun's beam (single
-    // scattering and the forward peak) after the cloud shadow map's optical depth toward the sun.
+    // scattering and the forward peak) after the cloud shadow map's optical depth toward the sun
+    // from where the beam enters the sprite's matter: sprite_beam dims it through the sprite
+    // itself, so the shadow map is read at the sunward side of the sprite's sphere through q,
+    // sqrt(r^2 - |q - centre|^2) = r / sqrt(2) sunward of q (corners lie r sqrt(2) out). The
+    // diffuse light is read where the light the eye gets from the sprite is scattered: at the mean
+    // depth of first scattering along the view through that sphere (sprite_scattering_depth).
     let q = mix(centre, p, 0.5);
+    let half_chord_m = radius * 0.70710678;
     let volume = s.layer < 4u && settings.lit_by_volume == 1u && environment_has_light_volume();
-    let tau_sun = environment_cloud_sun_optical_depth(q);
+    let tau_sun = environment_cloud_sun_optical_depth(q + environment_sun_direction() * half_chord_m);
     let volume_single = settings.albedo * environment_sun_irradiance(q);
-    let volume_diffuse = settings.albedo * environment_light_volume_diffuse(q, -view_dir);
+    let seen = q + view_dir * half_chord_m * (2.0 * sprite_scattering_depth(s.optical_depth) - 1.0);
+    let volume_diffuse = settings.albedo * environment_light_volume_diffuse(seen, -view_dir);
 
     var out: Varying;
     out.clip = sprite_clip(view, p);
