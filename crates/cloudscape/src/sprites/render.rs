@@ -849,6 +849,7 @@ pub static SPRITE_RENDER_WGSL: crate::shader::WgslModule = crate::shader::wgsl_m
         &crate::environment::ENVIRONMENT_WGSL,
         &crate::optics::phase::PHASE_WGSL,
         &crate::optics::slab::SLAB_WGSL,
+        &crate::raymarch::light::MARCH_LIGHT_WGSL,
         &super::views::SPRITE_WGSL
     ]
 );

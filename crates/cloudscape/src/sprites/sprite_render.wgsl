@@ -56,7 +56,7 @@ struct Varying {
     @location(0) uv: vec2<f32>,                 // on the puff sheet
     @location(1) diffuse: vec3<f32>,            // ambient + directional radiance
     @location(2) single: vec3<f32>,             // albedo x the sun's irradiance reaching the sprite (Wang: its group's)
-    @location(9) tau_sun: f32,                  // volume: the cloud shadow map's optical depth toward the sun
+    @location(9) tau_sun: f32,                  // volume: the optical depth toward the sun outside the sprite
     @location(7) thin_only: f32,                // 1: the single-scattered sun lights only thin parts
     @location(8) position_m: vec3<f32>,         // world position (the view ray's direction, per fragment)
     @location(3) opacity: f32,                  // fades and the level's opacity
@@ -67,6 +67,8 @@ struct Varying {
 
 // Sheet layout (sprites/textures.rs).
 const SHEET_TILES: f32 = 4.0;
+// Samples of a vertex's light path toward the sun (the ray marcher's High preset's, raymarch::preset).
+const SPRITE_LIGHT_STEPS: u32 = 6u;
 
 // Where the sprite's centre is now: its wind frame moved by its layer's drift.
 fn sprite_centre(s: Sprite) -> vec3<f32> {
@@ -141,16 +143,18 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     // Field sprites in a frame with a light volume: lit as the ray marcher lights a sample of
     // the field halfway between the sprite's centre and this corner (so a sprite shades from its
     // sunlit to its shadowed side): the volume's diffuse light, and the sun's beam (single
-    // scattering and the forward peak) after the cloud shadow map's optical depth toward the sun
-    // from where the beam enters the sprite's matter: sprite_beam dims it through the sprite
-    // itself, so the shadow map is read at the sunward side of the sprite's sphere through q,
+    // scattering and the forward peak) after the optical depth toward the sun from where the beam
+    // enters the sprite's matter, by the ray marcher's own light path (march_sun_optical_depth,
+    // through the eroded density's mean: the cloud shadow map's coarse density is its upper bound
+    // and dimmed the beam by 1.2-2 times the matter): sprite_beam dims it through the sprite
+    // itself, so the path starts at the sunward side of the sprite's sphere through q,
     // sqrt(r^2 - |q - centre|^2) = r / sqrt(2) sunward of q (corners lie r sqrt(2) out). The
     // diffuse light is read where the light the eye gets from the sprite is scattered: at the mean
     // depth of first scattering along the view through that sphere (sprite_scattering_depth).
     let q = mix(centre, p, 0.5);
     let half_chord_m = radius * 0.70710678;
     let volume = s.layer < 4u && settings.lit_by_volume == 1u && environment_has_light_volume();
-    let tau_sun = environment_cloud_sun_optical_depth(q + environment_sun_direction() * half_chord_m);
+    let tau_sun = march_sun_optical_depth(q + environment_sun_direction() * half_chord_m, SPRITE_LIGHT_STEPS, 0.5);
     let volume_single = settings.albedo * environment_sun_irradiance(q);
     let seen = q + view_dir * half_chord_m * (2.0 * sprite_scattering_depth(s.optical_depth) - 1.0);
     let volume_diffuse = settings.albedo * environment_light_volume_diffuse(seen, -view_dir);
