@@ -295,9 +295,9 @@ impl TileDraft {
     }
 
     /// The cloud of the candidates where the field is cloudy (`extinctions_per_m`, read at
-    /// [`Self::read_points_m`], of a layer whose densest extinction is `layer_extinction_per_m`), each sprite
-    /// wide enough to overlap its neighbours and as opaque as the matter of its cell (puffs of
-    /// mean cover `cover`); None where the tile is clear.
+    /// [`Self::read_points_m`], of a layer whose densest extinction is
+    /// `layer_extinction_per_m`), each sprite wide enough to overlap its neighbours and as opaque
+    /// as the matter of its cell (puffs of mean cover `cover`); None where the tile is clear.
     fn finish(
         &self,
         extinctions_per_m: &[f32],
