@@ -44,11 +44,12 @@ pub fn run(args: ReferenceArgs) -> Result<()> {
             .map_err(|e| anyhow!(doc.error_at(&e.key_path, e.message)))
     })?;
     let grid = tracer.volume.grid.dims();
+    // Graceful first, then the line a user (or a test) reacts to: a Ctrl-C after it keeps the work.
+    interrupt::stop_gracefully();
     eprintln!(
         "path tracing {}x{} at {} spp (majorant grid {}x{}x{})",
         size.x, size.y, args.spp, grid.x, grid.y, grid.z
     );
-    interrupt::stop_gracefully();
     let deadline = args.time_budget.and_then(deadline_after);
     let should_stop =
         || interrupt::stop_requested() || deadline.is_some_and(|d| Instant::now() >= d);
