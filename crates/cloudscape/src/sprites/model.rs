@@ -69,9 +69,9 @@ pub struct Sprite {
     pub texture: u32,
     /// The shading group it belongs to (an index into its cloud's groups).
     pub group: u32,
-    /// Opacity 0..1: a hand-made sprite's share of its chord's optical depth (the type's
-    /// opacity); a field sprite's optical depth over the most a sprite gets (the matter of its
-    /// cell, `from_field.rs`).
+    /// Opacity: a hand-made sprite's share (0..1) of its chord's optical depth (the type's
+    /// opacity); a field sprite's optical depth over the most a puff's opacity shows (the matter
+    /// of its cell, `from_field.rs`; above 1 for a cell denser than that).
     pub opacity: f32,
 }
 

@@ -48,7 +48,7 @@ struct SettingsUniform {
     phase_lobes: Vec4,
     albedo: f32,
     lit_by_volume: u32,
-    pad1: f32,
+    blend_optical_depth_max: f32,
     pad2: f32,
     slab_params: Vec4,
 }
@@ -649,6 +649,7 @@ impl Technique for SpriteRenderer {
                 phase_lobes: Vec4::from_array(PhaseLobes::from_scene(&scene.phase).to_gpu()),
                 albedo: scene.lighting.albedo,
                 lit_by_volume: u32::from(scene.lighting.model == LightingModel::Volume),
+                blend_optical_depth_max: super::shading::MAX_SPRITE_OPTICAL_DEPTH,
                 slab_params: Vec4::from_array(scene.sun_slab().params_to_gpu()),
                 ..SettingsUniform::zeroed()
             },
@@ -893,7 +894,7 @@ mod tests {
                 phase_lobes,
                 albedo,
                 lit_by_volume,
-                pad1,
+                blend_optical_depth_max,
                 pad2,
                 slab_params,
             }

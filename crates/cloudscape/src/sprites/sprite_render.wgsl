@@ -12,7 +12,7 @@ struct Sprite {
     rotation_rad: f32,          // about the view axis
     texture: u32,               // tile of the puff sheet, 0..15
     cloud: u32,                 // index into `clouds`
-    optical_depth: f32,         // through its densest column (cloud_set.rs)
+    optical_depth: f32,         // through its densest column (cloud_set.rs); may exceed the blend's cap
     directional: f32,           // its shading group's directional factor, 0..1
     sun_transmittance: f32,     // direct sun reaching its group, 0..1 (silver lining)
 }
@@ -37,7 +37,7 @@ struct Settings {
     phase_lobes: vec4<f32>,             // the scene's phase function (phase.wgsl)
     albedo: f32,                        // single-scattering albedo
     lit_by_volume: u32,                 // 1: field sprites read the frame's light volume
-    pad1: f32,
+    blend_optical_depth_max: f32,       // a puff's opacity stops growing here (its soft rim)
     pad2: f32,
     slab_params: vec4<f32>,             // the forward peak's beam (slab.wgsl, SunSlab)
 }
@@ -54,11 +54,15 @@ struct Settings {
 struct Varying {
     @builtin(position) clip: vec4<f32>,
     @location(0) uv: vec2<f32>,                 // on the puff sheet
-    @location(1) diffuse: vec3<f32>,            // ambient + directional radiance
+    @location(1) diffuse: vec3<f32>,            // Wang's ambient + directional radiance
     @location(2) single: vec3<f32>,             // albedo x the sun's irradiance reaching the sprite (Wang: its group's)
     @location(9) tau_sun: f32,                  // volume: the optical depth toward the sun outside the sprite
-    @location(7) thin_only: f32,                // 1: the single-scattered sun lights only thin parts
+    @location(7) thin_only: f32,                // 1: Wang's model (the sun lights thin parts only); 0: physics
     @location(8) position_m: vec3<f32>,         // world position (the view ray's direction, per fragment)
+    @location(10) disc: vec2<f32>,              // on the puff's disc, in radii (its sphere's chords)
+    @location(11) sun_local: vec3<f32>,         // the sun in the quad's frame: right, up, toward the eye
+    @location(12) normal: vec3<f32>,            // the quad's, toward the eye
+    @location(13) radius_m: f32,                // the puff's sphere
     @location(3) opacity: f32,                  // fades and the level's opacity
     @location(6) optical_depth: f32,            // the sprite's, through its densest column
     @location(4) distance_m: f32,
@@ -137,37 +141,38 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     let heights = array<f32, 5>(c.level_heights.x, c.level_heights.y, c.level_heights.z, c.level_heights.w, c.top_level_height);
     let level = sprite_level(c.colors, heights, clamp((p.y - c.bottom_y_m) / max(c.height_m, 1.0), 0.0, 1.0));
     let maxima = sprite_max_colours(p);
-    let view_dir = normalize(p - view.eye_m);
     let wang_diffuse = level.rgb * maxima[0] + s.directional * maxima[1];
     let wang_single = settings.albedo * environment_sun_irradiance(p) * s.sun_transmittance;
     // Field sprites in a frame with a light volume: lit as the ray marcher lights a sample of
-    // the field halfway between the sprite's centre and this corner (so a sprite shades from its
-    // sunlit to its shadowed side): the volume's diffuse light, and the sun's beam (single
-    // scattering and the forward peak) after the optical depth toward the sun from where the beam
-    // enters the sprite's matter, by the ray marcher's own light path (march_sun_optical_depth,
-    // through the eroded density's mean: the cloud shadow map's coarse density is its upper bound
-    // and dimmed the beam by 1.2-2 times the matter): sprite_beam dims it through the sprite
-    // itself, so the path starts at the sunward side of the sprite's sphere through q,
-    // sqrt(r^2 - |q - centre|^2) = r / sqrt(2) sunward of q (corners lie r sqrt(2) out). The
-    // diffuse light is read where the light the eye gets from the sprite is scattered: at the mean
-    // depth of first scattering along the view through that sphere (sprite_scattering_depth).
+    // the field (fs_sprite): the volume's diffuse light, and the sun's beam (single scattering
+    // and the forward peak) after the optical depth toward the sun from where the beam enters
+    // the sprite's matter, by the ray marcher's own light path (march_sun_optical_depth, through
+    // the eroded density's mean: the cloud shadow map's coarse density is its upper bound and
+    // dimmed the beam by 1.2-2 times the matter), read halfway between the sprite's centre and
+    // this corner, so a sprite shades from its sunlit to its shadowed side. sprite_beam dims it
+    // through the sprite itself, so the path starts at the sunward side of the sprite's sphere
+    // through q, sqrt(r^2 - |q - centre|^2) = r / sqrt(2) sunward of q (corners lie r sqrt(2)
+    // out).
     let q = mix(centre, p, 0.5);
     let half_chord_m = radius * 0.70710678;
     let volume = s.layer < 4u && settings.lit_by_volume == 1u && environment_has_light_volume();
     let tau_sun = march_sun_optical_depth(q + environment_sun_direction() * half_chord_m, SPRITE_LIGHT_STEPS, 0.5);
     let volume_single = settings.albedo * environment_sun_irradiance(q);
-    let seen = q + view_dir * half_chord_m * (2.0 * sprite_scattering_depth(s.optical_depth) - 1.0);
-    let volume_diffuse = settings.albedo * environment_light_volume_diffuse(seen, -view_dir);
 
     var out: Varying;
     out.clip = sprite_clip(view, p);
     let tile = vec2<f32>(f32(s.texture % 4u), f32(s.texture / 4u));
     out.uv = (tile + corner * vec2<f32>(0.5, -0.5) + 0.5) / SHEET_TILES;
-    out.diffuse = select(wang_diffuse, volume_diffuse, volume);
+    out.diffuse = wang_diffuse;
     out.single = select(wang_single, volume_single, volume);
     out.thin_only = select(1.0, 0.0, volume);
     out.tau_sun = tau_sun;
     out.position_m = p;
+    out.disc = turned;
+    out.normal = normal;
+    out.radius_m = radius;
+    let sun = environment_sun_direction();
+    out.sun_local = vec3<f32>(dot(sun, right), dot(sun, up), dot(sun, normal));
     out.opacity = level.a * through * edge_on * far;
     out.optical_depth = s.optical_depth;
     out.distance_m = length(p - view.eye_m);
@@ -175,31 +180,35 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     return out;
 }
 
-// The sun's beam that a sprite of optical depth `tau` scatters toward the eye, per unit of the
-// beam's irradiance times the albedo, after `tau_sun` of cloud toward the sun outside the sprite:
-// the ray marcher's per-sample beam (single scattering and the forward peak, slab_beam_scattering)
-// integrated through the sprite. The sun enters the side facing it, so a point at depth t from the
-// eye's side is reached through s(t) = tau (1 + c) / 2 - c t of the sprite (the far side's depth
-// when the sun is behind it, c = 1; t when it is behind the eye, c = -1; half the sprite from the
-// side), and the light it scatters leaves through t. The single-scattering part is closed-form: the
-// integral of exp(-t - s(t)) over [0, tau], exp(-tau (1 + c) / 2) (1 - exp(-tau (1 - c))) / (1 - c)
-// (a homogeneous slab, Chandrasekhar 1960, ch. I: tau for a thin one, tau exp(-tau) for a thick
-// one against the sun); the forward peak's beam, which a thick sprite against the sun keeps where
-// extinction alone would lose it, by 3-point Gauss-Legendre quadrature over t.
-fn sprite_beam(tau: f32, c: f32, tau_sun: f32) -> f32 {
+// Nodes of the beam's quadrature along a puff's chord.
+const BEAM_NODES: u32 = 4u;
+
+// The sun's beam that a puff scatters toward the eye through one point of its disc, per unit of
+// the beam's irradiance times the albedo and per unit of the puff's opacity there, after `tau_sun`
+// of cloud toward the sun outside it: the ray marcher's per-sample beam (single scattering and the
+// forward peak, slab_beam_scattering) averaged over where the eye's light is scattered along the
+// chord. The puff is a sphere of uniform matter, its column `tau` along the chord through `disc`
+// (in radii); a point at optical depth t from the eye's side is reached through the matter
+// between it and the sphere's surface toward the sun (`sun_local`, in the quad's frame, z toward
+// the eye), so a puff's sunlit side is lit and its far side shadowed by the puff itself, and a
+// dense puff against the sun passes only what its whole depth passes. The chord's points are
+// taken at equal shares of the light the eye gets from it (t = -ln(1 - u (1 - e^-tau))).
+fn sprite_beam(tau: f32, disc: vec2<f32>, sun_local: vec3<f32>, c: f32, tau_sun: f32) -> f32 {
     let slab = SlabModel(settings.phase_lobes, settings.slab_params);
-    let k = 1.0 - c;
-    let inner = select((1.0 - exp(-tau * k)) / max(k, 1e-6), tau, k < 1e-4);
-    let single = phase_eval(settings.phase_lobes, c) * exp(-tau_sun - 0.5 * tau * (1.0 + c)) * inner;
-    let nodes = array<f32, 3>(0.5 - 0.5 * sqrt(0.6), 0.5, 0.5 + 0.5 * sqrt(0.6));
-    let weights = array<f32, 3>(5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0);
-    var peak = 0.0;
-    for (var i = 0u; i < 3u; i++) {
-        let t = tau * nodes[i];
-        let through = tau_sun + 0.5 * tau * (1.0 + c) - c * t;
-        peak += weights[i] * exp(-t) * slab_peak_beam(slab, c, through);
+    let half = sqrt(max(1.0 - dot(disc, disc), 0.0));
+    let per_radius = tau / max(2.0 * half, 1e-3);
+    let seen = 1.0 - exp(-tau);
+    let phase = phase_eval(settings.phase_lobes, c);
+    var sum = 0.0;
+    for (var i = 0u; i < BEAM_NODES; i++) {
+        let t = -log(1.0 - (f32(i) + 0.5) / f32(BEAM_NODES) * seen);
+        let point = vec3<f32>(disc, half - t / max(per_radius, 1e-6));
+        let b = dot(point, sun_local);
+        let to_surface = -b + sqrt(max(b * b - dot(point, point) + 1.0, 0.0));
+        let through = tau_sun + per_radius * to_surface;
+        sum += phase * exp(-through) + slab_peak_beam(slab, c, through);
     }
-    return single + tau * peak;
+    return sum / f32(BEAM_NODES);
 }
 
 @fragment
@@ -211,17 +220,33 @@ fn fs_sprite(in: Varying) -> SpriteTargets {
     let fade = sprite_host_fade(depth, texel, in.distance_m, in.soft_m);
     // A select, not a branch on the uniform alone (sprite_max_colours says why).
     let visible = in.opacity * select(1.0, fade, view.host_depth_test == 1u);
+    // The puff's opacity stops at the blend's cap, so that its rim stays soft however dense its
+    // cell (sprites/textures.rs tests the rim there); the light it sends per unit of opacity is
+    // its whole matter's (sprite_beam): a dense puff against the sun passes only what its full
+    // depth passes (with the cap's depth of 3 in its light too, every dense puff against the sun
+    // scattered p tau e^-tau = 0.15 p of the beam).
     let tau = in.optical_depth * cover;
-    let alpha = (1.0 - exp(-tau)) * visible;
+    let tau_blend = min(in.optical_depth, settings.blend_optical_depth_max) * cover;
+    let alpha = (1.0 - exp(-tau_blend)) * visible;
     // Wang's model: thin parts of a puff scatter the direct sun once toward the eye (premultiplied,
     // E p tau ~ E p alpha for thin matter), its thick core's light is the diffuse term's. Lit from
     // physics: the sun's beam through the sprite, as the ray marcher's samples scatter it.
     let thin = alpha * (1.0 - cover) * (1.0 - cover);
     // The phase function peaks sharply toward the sun: the angle is the fragment's own, not
     // interpolated across a quad that may span tens of degrees.
-    let cos_sun = dot(normalize(in.position_m - view.eye_m), environment_sun_direction());
-    let beam = sprite_beam(tau, cos_sun, in.tau_sun) * visible;
+    let view_dir = normalize(in.position_m - view.eye_m);
+    let cos_sun = dot(view_dir, environment_sun_direction());
+    let beam = sprite_beam(tau, in.disc, normalize(in.sun_local), cos_sun, in.tau_sun) * alpha;
     let silver = thin * phase_eval(settings.phase_lobes, cos_sun);
-    let radiance = alpha * in.diffuse + mix(beam, silver, in.thin_only) * in.single;
+    // The light volume's diffuse light where the eye's light is scattered along this fragment's
+    // chord through the puff's sphere: at its mean depth of first scattering from the sphere's
+    // surface on the eye's side (read at one point per vertex, halfway to the sprite's centre,
+    // the sprites missed the glow of the surface the eye sees: inside the layer 0.504 -> 0.461).
+    let half = sqrt(max(1.0 - dot(in.disc, in.disc), 0.0));
+    let scattered_r = 2.0 * half * sprite_scattering_depth(tau);
+    let seen = in.position_m + in.normal * in.radius_m * (half - scattered_r);
+    let fragment_diffuse = settings.albedo * environment_light_volume_diffuse(seen, -view_dir);
+    let diffuse = select(in.diffuse, fragment_diffuse, in.thin_only < 0.5);
+    let radiance = alpha * diffuse + mix(beam, silver, in.thin_only) * in.single;
     return sprite_targets(radiance, alpha, in.distance_m);
 }
