@@ -223,7 +223,10 @@ impl FileCloud {
                     rotation_deg: s.rotation_rad.to_degrees(),
                     texture: s.texture,
                     group: s.group,
-                    opacity: s.opacity,
+                    // A model's clouds are drawn as hand-made ones, whose opacity is a share of
+                    // their chord's depth: a field sprite denser than a puff shows (above 1,
+                    // `from_field.rs`) is written as a whole one.
+                    opacity: s.opacity.min(1.0),
                 })
                 .collect(),
         }
