@@ -180,13 +180,18 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     return out;
 }
 
+// Half the chord through a puff's sphere at `disc` on its disc, in radii.
+fn sprite_half_chord(disc: vec2<f32>) -> f32 {
+    return sqrt(max(1.0 - dot(disc, disc), 0.0));
+}
+
 // Nodes of the beam's quadrature along a puff's chord.
 const BEAM_NODES: u32 = 4u;
 
 // The sun's beam that a puff scatters toward the eye through one point of its disc, per unit of
 // the beam's irradiance times the albedo and per unit of the puff's opacity there, after `tau_sun`
 // of cloud toward the sun outside it: the ray marcher's per-sample beam (single scattering and the
-// forward peak, slab_beam_scattering) averaged over where the eye's light is scattered along the
+// forward peak's beam, slab_peak_beam) averaged over where the eye's light is scattered along the
 // chord. The puff is a sphere of uniform matter, its column `tau` along the chord through `disc`
 // (in radii); a point at optical depth t from the eye's side is reached through the matter
 // between it and the sphere's surface toward the sun (`sun_local`, in the quad's frame, z toward
@@ -195,7 +200,7 @@ const BEAM_NODES: u32 = 4u;
 // taken at equal shares of the light the eye gets from it (t = -ln(1 - u (1 - e^-tau))).
 fn sprite_beam(tau: f32, disc: vec2<f32>, sun_local: vec3<f32>, c: f32, tau_sun: f32) -> f32 {
     let slab = SlabModel(settings.phase_lobes, settings.slab_params);
-    let half = sqrt(max(1.0 - dot(disc, disc), 0.0));
+    let half = sprite_half_chord(disc);
     let per_radius = tau / max(2.0 * half, 1e-3);
     let seen = 1.0 - exp(-tau);
     let phase = phase_eval(settings.phase_lobes, c);
@@ -242,7 +247,7 @@ fn fs_sprite(in: Varying) -> SpriteTargets {
     // chord through the puff's sphere: at its mean depth of first scattering from the sphere's
     // surface on the eye's side (read at one point per vertex, halfway to the sprite's centre,
     // the sprites missed the glow of the surface the eye sees: inside the layer 0.504 -> 0.461).
-    let half = sqrt(max(1.0 - dot(in.disc, in.disc), 0.0));
+    let half = sprite_half_chord(in.disc);
     let scattered_r = 2.0 * half * sprite_scattering_depth(tau);
     let seen = in.position_m + in.normal * in.radius_m * (half - scattered_r);
     let fragment_diffuse = settings.albedo * environment_light_volume_diffuse(seen, -view_dir);
