@@ -346,6 +346,19 @@ fn bench_flythrough_spread_compares_both_marches_with_converged_frames() {
 }
 
 #[test]
+fn bench_flythrough_without_a_run_of_references_says_so() {
+    let scratch = Scratch::new("bench-flythrough-no-run");
+    let scene = flythrough_scene();
+    let args = ["bench", "--flythrough", &scene, "--frames", "12"];
+    let run = cloudscape(scratch.path(), &args, false);
+    assert!(
+        !run.success && run.stderr.contains("--reference-every 60 leaves no frame"),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
 fn bench_flythrough_at_a_frame_rate_marches_every_frame_and_references_runs() {
     let scratch = Scratch::new("bench-flythrough-fps");
     let scene = flythrough_scene();

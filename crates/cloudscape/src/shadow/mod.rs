@@ -206,19 +206,35 @@ pub struct BuiltShadow {
 
 impl BuiltShadow {
     /// Whether this map still serves a frame that would build `fresh` while the clouds move at
-    /// `wind_m_per_s`: the same sun, size and settings, and its centre and the clouds within
-    /// `reuse`'s drift.
+    /// `wind_m_per_s`: the same size and settings, and its centre, the clouds and the shadows
+    /// the sun casts within `reuse`'s drift. A sun that moves (a time of day that passes) shifts
+    /// the shadow of a cloud `h` metres over the lowest point the map serves by `h` times the
+    /// change of its slope `sun.xz / sun.y`: a few metres a frame, so the map is kept, not rebuilt
+    /// every frame as an exact match of the sun would have it. (On a sphere the sun's slant also
+    /// lowers the map's bottom a little, by as much as it moves; that counts as drift too.)
     pub fn serves(&self, fresh: &BuiltShadow, wind_m_per_s: Vec2, reuse: LightingReuse) -> bool {
         let recentred = ShadowParams {
             centre_m: self.params.centre_m,
+            sun_y: self.params.sun_y,
+            bottom_y_m: self.params.bottom_y_m,
             ..fresh.params
         };
-        if recentred != self.params || fresh.sun != self.sun || fresh.texels != self.texels {
+        if recentred != self.params || fresh.texels != self.texels {
             return false;
         }
         let eye_m = (fresh.params.centre_m - self.params.centre_m).length();
         let clouds_m = wind_m_per_s.length() * (fresh.time_s - self.time_s).abs();
-        eye_m + clouds_m <= reuse.max_shadow_drift_texels * self.params.finest_texel_m(self.texels)
+        let span_m = self.params.top_y_m - self.params.bottom_y_m.min(0.0);
+        let sun_m = span_m * (fresh.sun_slope() - self.sun_slope()).length();
+        let bottom_m = (fresh.params.bottom_y_m - self.params.bottom_y_m).abs();
+        eye_m + clouds_m + sun_m + bottom_m
+            <= reuse.max_shadow_drift_texels * self.params.finest_texel_m(self.texels)
+    }
+
+    /// How far the shadows lie from what casts them per metre of height: the sun's `xz` over its
+    /// `y` (as the map's columns rise, [`ShadowParams::rise`]).
+    fn sun_slope(&self) -> Vec2 {
+        Vec2::new(self.sun.x, self.sun.z) / self.params.sun_y
     }
 }
 

@@ -111,6 +111,16 @@ fn a_built_map_serves_until_the_eye_and_the_clouds_drift_too_far() {
     assert!(served(at(0.0, 0.9 * half_texel_s, sun())));
     assert!(!served(at(0.3 * texel_m, 0.5 * half_texel_s, sun())));
     assert!(!served(at(0.0, 0.0, Vec3::Y)));
+    // A sun that moves shifts the highest clouds' shadows by its slope's change times their height.
+    let span_m = built.params.top_y_m - built.params.bottom_y_m.min(0.0);
+    let tilted = |shift_m: f32| {
+        let s = sun();
+        let slope = Vec2::new(s.x, s.z) / s.y + Vec2::new(shift_m / span_m, 0.0);
+        Vec3::new(slope.x, 1.0, slope.y).normalize()
+    };
+    assert!(served(at(0.0, 0.0, tilted(0.4 * texel_m))));
+    assert!(!served(at(0.0, 0.0, tilted(0.6 * texel_m))));
+    assert!(!served(at(0.3 * texel_m, 0.0, tilted(0.3 * texel_m))));
     assert!(!served(BuiltShadow {
         texels: 128,
         ..built

@@ -114,6 +114,17 @@ pub fn run(mut args: BenchArgs) -> Result<()> {
         Pacing::Spread(_) => 1,
         Pacing::Fps(..) => DEFAULT_REFERENCE_EVERY,
     });
+    let runs = Runs {
+        every: reference_every,
+    };
+    if !(0..times.len()).any(|i| runs.has_references(i)) {
+        bail!(
+            "--reference-every {reference_every} leaves no frame with references in {} frames: \
+             give at least {RUN_FRAMES} frames per run (--reference-every {RUN_FRAMES}..={})",
+            times.len(),
+            times.len()
+        );
+    }
     let ctx = args.gpu.open(&doc)?;
     let base_dir = doc.resolve_path("");
     let renderer = SceneRenderer::new(&ctx, scene, &base_dir)
@@ -138,9 +149,6 @@ pub fn run(mut args: BenchArgs) -> Result<()> {
     let marches = (temporal_reuse(divisor), setup.reference);
     let mut measurer = Measurer::new(&ctx, (renderer, base_dir), setup.clock, marches);
     measurer.warm_up(&scene_at(scene, times[0]), args.warmup);
-    let runs = Runs {
-        every: reference_every,
-    };
     let records = measure_all(&mut measurer, scene, (&times, runs), fly.out.as_deref())?;
     Report::new(setup, records).print(args.json)
 }
