@@ -15,6 +15,9 @@
 // LIGHT_VOLUME_ROW_TEXELS for the copy into the 3-D texture: I0 of each cascade side by side along
 // z, then J / I0 the same way, then the ground's irradiance under each column in the bottom row.
 @group(3) @binding(3) var<storage, read_write> volume_table_out: array<vec2<u32>>;
+// Per cascade (xy): where this frame's cells lay in the grid the radiance was solved on, in whole
+// cells along x and z (LightVolumeGrid::shift_cells_from); read by light_volume_scroll only.
+@group(3) @binding(4) var<uniform> volume_shift_cells: array<vec4<i32>, LIGHT_VOLUME_MAX_CASCADES>;
 
 const LIGHT_VOLUME_LUMINANCE = vec3<f32>(0.2126, 0.7152, 0.0722);
 
@@ -366,4 +369,22 @@ fn light_volume_bottom_irradiance(i: u32, h_y: f32) -> vec3<f32> {
     let entering = light_volume_entering(i, -1);
     let radiance = volume_radiance[i].rgb;
     return PI * (entering.alpha * radiance + entering.beta) + 4.0 * PI * (face[0] * radiance + face[1]);
+}
+
+// Scrolls the solution of a grid recentred by whole cells (LightVolumePass), so that the solve
+// starts warm instead of cold: each cell takes the radiance the last solution held at the same
+// place, and a cell new to the grid that of the nearest old cell in its row. The last solution
+// is read from the table's buffer, where the pass copied it (the export overwrites it later in
+// the frame): two of its texels hold one cell's vec4<f32>.
+@compute @workgroup_size(8, 8)
+fn light_volume_scroll(@builtin(global_invocation_id) id: vec3<u32>) {
+    if !light_volume_in_cells(id.xy) {
+        return;
+    }
+    let c = light_volume_cell_of(id.xy);
+    let last = vec2<i32>(light_volume_cells_of().xz) - 1;
+    let at = clamp(vec2<i32>(c.xz) + volume_shift_cells[c.w].xy, vec2<i32>(0), last);
+    let texel = 2u * light_volume_index(vec3<u32>(u32(at.x), c.y, u32(at.y)), c.w);
+    let radiance = vec4<f32>(bitcast<vec2<f32>>(volume_table_out[texel]), bitcast<vec2<f32>>(volume_table_out[texel + 1u]));
+    volume_radiance[light_volume_index(c.xyz, c.w)] = radiance;
 }

@@ -17,7 +17,8 @@
 //! **Per cell** ([`inputs`]): the δ-scaled extinction, the mean field (`CloudField::mean_extinction_per_m`) at eight points
 //! of the cell, and the scaled sun beam's irradiance, the sun's irradiance there through the air
 //! times `exp(-tau')` of the mean field toward the sun. **Solve**: line relaxation, warm-started
-//! from the last frame's solution when the grid has not moved. **Read**: the march scatters
+//! from the last frame's solution when the grid has not moved, and from that solution scrolled by
+//! whole cells when it was recentred ([`LightVolumeGrid::shift_cells_from`]). **Read**: the march scatters
 //! `I0 + g w . I1` toward the eye along `w` (`environment_light_volume_diffuse`): per cell the
 //! volume stores `I0` (RGB) and the current `J = I1 / 3` over `I0` (of luminance).
 //!
@@ -37,7 +38,7 @@ pub use solve::{Boundaries, DiffuseField, Diffusion};
 use crate::field::CloudField;
 use crate::optics::SunSlab;
 use crate::scene::{PlanetShape, Scene};
-use glam::{UVec3, Vec3};
+use glam::{IVec2, UVec3, Vec3};
 
 /// Most cascades a volume holds.
 pub const MAX_CASCADES: u32 = 4;
@@ -192,6 +193,26 @@ impl LightVolumeGrid {
             && self.enabled == fresh.enabled
             && self.cascades.len() == fresh.cascades.len()
             && self.cascades.iter().zip(&fresh.cascades).all(near)
+    }
+
+    /// Where each cascade's cells lay in `solved`, an earlier grid of the same cells through the
+    /// same heights, as whole cells along x and z: cell `c` of this grid is cell `c + shift` of
+    /// `solved`. None when the two grids do not line up (other cells, sizes or heights), when a
+    /// recentred grid cannot start from the old solution.
+    pub fn shift_cells_from(&self, solved: &LightVolumeGrid) -> Option<Vec<IVec2>> {
+        let same = self.cells == solved.cells
+            && self.enabled == solved.enabled
+            && self.cascades.len() == solved.cascades.len();
+        let shift = |(new, old): (&LightVolumeCascade, &LightVolumeCascade)| {
+            let cells = (new.min_m - old.min_m) / new.cell_m;
+            let whole = cells.round();
+            let lines_up = new.cell_m == old.cell_m
+                && new.min_m.y == old.min_m.y
+                && (cells - whole).abs().max_element() < 1e-3;
+            lines_up.then(|| IVec2::new(whole.x as i32, whole.z as i32))
+        };
+        let shifts = self.cascades.iter().zip(&solved.cascades).map(shift);
+        same.then(|| shifts.collect::<Option<Vec<_>>>()).flatten()
     }
 }
 

@@ -3,12 +3,12 @@
 
 use super::inputs::{BEAM_GROWTH, BEAM_MIN_SUN_Y, BEAM_PATH_MAX_M, CELL_SAMPLE_OFFSET};
 use super::solve::MAX_COLUMN_CELLS;
-use super::{LightVolumeGrid, LightVolumeSettings, TABLE_PARTS};
+use super::{LightVolumeGrid, LightVolumeSettings, MAX_CASCADES, TABLE_PARTS};
 use crate::environment::{EnvironmentGpu, EnvironmentTable};
-use crate::gpu::pipeline::storage_buffer;
+use crate::gpu::pipeline::{storage_buffer, uniform_buffer};
 use crate::gpu::{GpuContext, PassTimer};
 use crate::pass::{BindGroupCache, ComputePass, Shared};
-use glam::UVec2;
+use glam::{IVec4, UVec2};
 
 /// Labels the passes are timed under: the cells' inputs, the solve's sweeps, the table.
 pub const LIGHT_VOLUME_PASS_NAMES: [&str; 3] = [
@@ -17,7 +17,7 @@ pub const LIGHT_VOLUME_PASS_NAMES: [&str; 3] = [
     "light volume table",
 ];
 
-const ENTRIES: [&str; 8] = [
+const ENTRIES: [&str; 9] = [
     "light_volume_cells",
     "light_volume_cells_slice",
     "light_volume_limit",
@@ -26,6 +26,7 @@ const ENTRIES: [&str; 8] = [
     "light_volume_relax_red_uncoupled",
     "light_volume_relax_black_uncoupled",
     "light_volume_export",
+    "light_volume_scroll",
 ];
 
 /// Slices the cells' rows are updated in on warm frames, one a frame: a warm frame recomputes the
@@ -42,6 +43,8 @@ const ROW_TEXELS: u32 = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT / 8;
 pub struct LightVolumePass {
     pass: ComputePass,
     buffers: Option<[wgpu::Buffer; 4]>,
+    /// Per cascade, how far a recentred grid's cells moved (`volume_shift_cells`).
+    shift: wgpu::Buffer,
     group: BindGroupCache,
     solved: Option<LightVolumeGrid>,
 }
@@ -52,6 +55,7 @@ impl LightVolumePass {
         LightVolumePass {
             pass: ComputePass::new(ctx, shared, "light volume", &LIGHT_VOLUME_WGSL, &ENTRIES),
             buffers: None,
+            shift: uniform_buffer(ctx, "light volume shift", 16 * u64::from(MAX_CASCADES)),
             group: BindGroupCache::default(),
             solved: None,
         }
@@ -83,8 +87,10 @@ impl LightVolumePass {
     }
 
     /// Records the frame's volume for `grid` (the environment's uniform already holds it): a cold
-    /// solve of `settings.sweeps` sweeps when the grid is new or moved or the frame may not start
-    /// warm, else `warm_sweeps` from the last solution.
+    /// solve of `settings.sweeps` sweeps when the grid is new or the frame may not start warm;
+    /// when the grid was recentred by whole cells, the last solution scrolled with it, every
+    /// cell's inputs and `warm_sweeps` more sweeps than it moved cells (the solution spreads a
+    /// cell a sweep into the new columns); else `warm_sweeps` from the last solution.
     pub fn encode(
         &mut self,
         ctx: &GpuContext,
@@ -99,12 +105,40 @@ impl LightVolumePass {
         );
         let cascades = grid.cascades.len() as u32;
         let remade = self.ensure_buffers(ctx, grid);
-        let cold = remade || !may_start_warm || self.solved.as_ref() != Some(grid);
+        let shift = match (&self.solved, remade || !may_start_warm) {
+            (Some(solved), false) => grid.shift_cells_from(solved),
+            _ => None,
+        };
+        let moved_cells = shift.as_ref().map(|s| {
+            let most = s.iter().map(|c| c.abs().max_element()).max();
+            most.unwrap_or(0) as u32
+        });
         let buffers = self.buffers.as_ref().expect("made above");
-        if cold {
-            encoder.clear_buffer(&buffers[1], 0, None);
+        let n = grid.cells;
+        let over_cells = UVec2::new(n.x, n.y * n.z * cascades);
+        let mut first = Vec::new();
+        match moved_cells {
+            None => {
+                encoder.clear_buffer(&buffers[1], 0, None);
+                first.push((ENTRIES[0], over_cells));
+            }
+            Some(0) => first.push((
+                ENTRIES[1],
+                UVec2::new(n.x, over_cells.y.div_ceil(CELL_SLICES)),
+            )),
+            Some(_) => {
+                let mut cells = [IVec4::ZERO; MAX_CASCADES as usize];
+                for (c, s) in cells.iter_mut().zip(shift.iter().flatten()) {
+                    *c = s.extend(0).extend(0);
+                }
+                ctx.queue
+                    .write_buffer(&self.shift, 0, bytemuck::cast_slice(&cells));
+                encoder.copy_buffer_to_buffer(&buffers[1], 0, &buffers[3], 0, buffers[1].size());
+                first.extend([(ENTRIES[8], over_cells), (ENTRIES[0], over_cells)]);
+            }
         }
         let pass = &self.pass;
+        let shift_buffer = &self.shift;
         let group = self.group.get(&[], || {
             pass.group.bind(
                 ctx,
@@ -113,22 +147,20 @@ impl LightVolumePass {
                     ("volume_radiance", buffers[1].as_entire_binding()),
                     ("volume_diffusion", buffers[2].as_entire_binding()),
                     ("volume_table_out", buffers[3].as_entire_binding()),
+                    ("volume_shift_cells", shift_buffer.as_entire_binding()),
                 ],
             )
         });
         let writing = environment.bind_group_writing(EnvironmentTable::LightVolume);
         let groups = shared.bind_groups_with(pass.slots, writing, group);
-        let n = grid.cells;
-        let over_cells = UVec2::new(n.x, n.y * n.z * cascades);
         let over_columns = UVec2::new(n.x, n.z * cascades);
-        let sweeps = if cold {
-            settings.sweeps.max(1)
-        } else {
-            settings.warm_sweeps
+        let sweeps = match moved_cells {
+            None => settings.sweeps.max(1),
+            Some(moved) => (settings.warm_sweeps + moved).min(settings.sweeps.max(1)),
         };
         let mut steps = Vec::new();
         for s in 0..sweeps {
-            let coupled = !(cold && s == 0);
+            let coupled = !(moved_cells.is_none() && s == 0);
             steps.push((ENTRIES[2], over_cells));
             let (red, black) = if coupled { (3, 4) } else { (5, 6) };
             steps.push((ENTRIES[red], over_columns));
@@ -153,14 +185,7 @@ impl LightVolumePass {
                 compute.dispatch_workgroups(size.x.div_ceil(8), size.y.div_ceil(8), 1);
             }
         };
-        let cells = match cold {
-            true => (ENTRIES[0], over_cells),
-            false => (
-                ENTRIES[1],
-                UVec2::new(n.x, over_cells.y.div_ceil(CELL_SLICES)),
-            ),
-        };
-        record(cells_name, &[cells]);
+        record(cells_name, &first);
         record(solve_name, &steps);
         record(table_name, &[(ENTRIES[7], over_cells)]);
         copy_table(

@@ -6,7 +6,7 @@ use super::{DiffuseOptics, LightVolumeCascade};
 use crate::optics::PhaseLobes;
 use crate::optics::slab::{ScaledSlab, diffuse_moments};
 use crate::scene::Scene;
-use glam::{UVec3, Vec3};
+use glam::{IVec2, UVec3, Vec2, Vec3};
 
 fn droplets() -> DiffuseOptics {
     let scene = Scene::default();
@@ -268,4 +268,35 @@ fn the_cascades_blend_without_a_seam() {
         largest <= 1.01 * smooth,
         "largest step {largest}, a linear hand-over {smooth}"
     );
+}
+
+/// A grid recentred under a moving eye lines up with the one it replaces by whole cells of each
+/// cascade, which the GPU scrolls the last solution by; a grid through other heights does not.
+#[test]
+fn a_recentred_grid_lines_up_with_the_last_by_whole_cells() {
+    use super::{LightVolumeGrid, LightVolumeSettings};
+    use crate::field::CloudField;
+    let scene = Scene::default();
+    let field = CloudField::new(&scene, std::path::Path::new(".")).expect("the default field");
+    let settings = LightVolumeSettings::from_scene(&scene);
+    let old = LightVolumeGrid::new(&settings, &field, Vec3::ZERO);
+    let cell_m = old.cascades[0].cell_m.x;
+    let new = LightVolumeGrid::new(
+        &settings,
+        &field,
+        Vec3::new(6.2 * cell_m, 0.0, -2.7 * cell_m),
+    );
+    let shift = new.shift_cells_from(&old).expect("the grids line up");
+    assert_eq!(shift.len(), old.cascades.len());
+    for (k, (s, cascade)) in shift.iter().zip(&new.cascades).enumerate() {
+        let moved = (cascade.min_m - old.cascades[k].min_m) / cascade.cell_m;
+        let error = (s.as_vec2() - Vec2::new(moved.x, moved.z))
+            .abs()
+            .max_element();
+        assert!(error < 1e-3, "cascade {k}: {s} for {moved}");
+    }
+    assert_eq!(shift[0], IVec2::new(6, -3));
+    let mut higher = new.clone();
+    higher.cascades[0].min_m.y += 10.0;
+    assert!(higher.shift_cells_from(&old).is_none());
 }
