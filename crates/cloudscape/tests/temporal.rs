@@ -203,9 +203,9 @@ fn lighting_carried_across_frames_keeps_the_image_of_a_still() {
     // Lit before, then carried over to the later frames: the light volume's cells updated a slice
     // a frame (every slice comes round), the solve warm-started, the shadow map rebuilt as it drifts.
     let mut carried = SceneRenderer::new(&ctx, &scene, Path::new(".")).expect("field");
-    carried.clouds().set_lighting_reuse(Some(LightingReuse {
-        max_shadow_drift_texels: 0.5,
-    }));
+    carried
+        .clouds()
+        .set_lighting_reuse(Some(LightingReuse::REAL_TIME));
     carried.render_frame(&ctx, &before, Reuse::None, &mut timer);
     for _ in 0..2 * CELL_SLICES {
         carried.render_frame(&ctx, &later, Reuse::None, &mut timer);

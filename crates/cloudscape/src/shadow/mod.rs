@@ -78,6 +78,15 @@ impl ShadowParams {
         self.warp * 2.0 * self.half_extent_m / texels.max(1) as f32
     }
 
+    /// How many times larger than the finest texel the map's texel over ground point `g` is, along
+    /// its coarser axis: the warp's slope `k + 2 (1 - k) |s|` at `g`'s texel coordinate `s`, over
+    /// `k`.
+    pub fn texel_growth_at(&self, g: Vec2) -> f32 {
+        let offset = (g - self.centre_m) / self.half_extent_m;
+        let s = self.coord_of(offset.x).abs().max(self.coord_of(offset.y).abs());
+        (self.warp + 2.0 * (1.0 - self.warp) * s) / self.warp
+    }
+
     /// Ground-plane offset in half extents of texel coordinate `s` in `[-1, 1]`:
     /// `s (k + (1 - k) |s|)` (`cloud_shadow_offset`).
     pub fn offset_of(&self, s: f32) -> f32 {
@@ -167,29 +176,41 @@ impl ShadowParams {
 }
 
 /// Reuse of the lighting across frames, for a real-time host. The shadow map is built once and read
-/// until the eye or the clouds have moved too far, the sun has moved or the map's settings changed;
-/// between builds the shadows lag the clouds by at most the drift allowed. The light volume's solve
-/// starts from the last frame's solution (the scene's `lighting.volume_warm_sweeps` sweeps a frame)
-/// and its grid is recentred only once the eye has moved
+/// until the clouds or the sun have moved its shadows too far, the eye has moved so far that the
+/// texels under it have grown too coarse, or the map's settings changed; between builds the
+/// shadows lag the clouds by at most the drift allowed. The light volume's solve starts from the
+/// last frame's solution (the scene's `lighting.volume_warm_sweeps` sweeps a frame) and its grid
+/// is recentred only once the eye has moved
 /// [`crate::environment::light_volume::RECENTRE_CELLS`] cells. The sprite technique remakes its
 /// clouds over frames after an edit of coverage, nearest the eye first
 /// ([`crate::technique::FrameInputs::real_time`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightingReuse {
-    /// The map is rebuilt once its centre (under the eye) and the clouds (with the wind) have
-    /// moved, together, this many of its finest texels since it was built.
+    /// The map is rebuilt once the shadows it holds lie this many of its finest texels from where
+    /// the clouds cast them now (the clouds moved with the wind, the sun moved).
     pub max_shadow_drift_texels: f32,
+    /// The map is rebuilt once the texel under the eye is this share larger than its finest:
+    /// the map stays in place as the eye moves, its warp's fine texels left behind.
+    pub max_texel_growth: f32,
 }
 
 impl LightingReuse {
-    /// What a game at a real-time frame rate carries: the shadow map kept until the eye and the
-    /// clouds have drifted half of its finest texel (about 120 m under the eye in the default
-    /// scene), a lag of the clouds' shadows no one sees, for a pass that costs more than the rest
-    /// of the frame on a software adapter; the light volume warm-started.
+    /// What a game at a real-time frame rate carries: the shadow map kept until the clouds' shadows
+    /// have drifted half of its finest texel (about 120 m in the default scene), a lag no one sees,
+    /// or the eye has moved until the texel under it is a quarter larger (about 1.2 km in the
+    /// default scene: a rebuild every 1.2 s at 1 km/s, not every 7 frames as when the eye's move
+    /// counted as drift), for a pass that costs more than the rest of the frame on a software
+    /// adapter; the light volume warm-started.
     pub const REAL_TIME: LightingReuse = LightingReuse {
         max_shadow_drift_texels: 0.5,
+        max_texel_growth: 0.25,
     };
 }
+
+/// A kept map is rebuilt once the eye has moved this share of its reach (the camera's far
+/// distance) from where it was built: ahead of the eye it still reaches 98 % as far. (Without a
+/// warp the texels do not grow as the eye moves; this bounds the move.)
+pub const MAX_SHADOW_REACH_LOSS: f32 = 0.02;
 
 /// What a built map was built for.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -206,12 +227,13 @@ pub struct BuiltShadow {
 
 impl BuiltShadow {
     /// Whether this map still serves a frame that would build `fresh` while the clouds move at
-    /// `wind_m_per_s`: the same size and settings, and its centre, the clouds and the shadows
-    /// the sun casts within `reuse`'s drift. A sun that moves (a time of day that passes) shifts
-    /// the shadow of a cloud `h` metres over the lowest point the map serves by `h` times the
-    /// change of its slope `sun.xz / sun.y`: a few metres a frame, so the map is kept, not rebuilt
-    /// every frame as an exact match of the sun would have it. (On a sphere the sun's slant also
-    /// lowers the map's bottom a little, by as much as it moves; that counts as drift too.)
+    /// `wind_m_per_s`: the same size and settings, the shadows it holds within `reuse`'s drift of
+    /// where the clouds cast them now, and the texel under the new eye within `reuse`'s growth.
+    /// A sun that moves (a time of day that passes) shifts the shadow of a cloud `h` metres over
+    /// the lowest point the map serves by `h` times the change of its slope `sun.xz / sun.y`: a
+    /// few metres a frame, so the map is kept, not rebuilt every frame as an exact match of the
+    /// sun would have it. (On a sphere the sun's slant also lowers the map's bottom a little, by
+    /// as much as it moves; that counts as drift too.)
     pub fn serves(&self, fresh: &BuiltShadow, wind_m_per_s: Vec2, reuse: LightingReuse) -> bool {
         let recentred = ShadowParams {
             centre_m: self.params.centre_m,
@@ -222,13 +244,16 @@ impl BuiltShadow {
         if recentred != self.params || fresh.texels != self.texels {
             return false;
         }
-        let eye_m = (fresh.params.centre_m - self.params.centre_m).length();
         let clouds_m = wind_m_per_s.length() * (fresh.time_s - self.time_s).abs();
         let span_m = self.params.top_y_m - self.params.bottom_y_m.min(0.0);
         let sun_m = span_m * (fresh.sun_slope() - self.sun_slope()).length();
         let bottom_m = (fresh.params.bottom_y_m - self.params.bottom_y_m).abs();
-        eye_m + clouds_m + sun_m + bottom_m
-            <= reuse.max_shadow_drift_texels * self.params.finest_texel_m(self.texels)
+        let drift_m = clouds_m + sun_m + bottom_m;
+        let growth = self.params.texel_growth_at(fresh.params.centre_m);
+        let eye_m = (fresh.params.centre_m - self.params.centre_m).length();
+        drift_m <= reuse.max_shadow_drift_texels * self.params.finest_texel_m(self.texels)
+            && growth <= 1.0 + reuse.max_texel_growth
+            && eye_m <= MAX_SHADOW_REACH_LOSS * self.params.half_extent_m
     }
 
     /// How far the shadows lie from what casts them per metre of height: the sun's `xz` over its

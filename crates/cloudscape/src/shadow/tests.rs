@@ -80,7 +80,7 @@ fn the_map_reads_the_columns_and_a_clear_sky_casts_nothing() {
 }
 
 #[test]
-fn a_built_map_serves_until_the_eye_and_the_clouds_drift_too_far() {
+fn a_built_map_serves_until_its_shadows_drift_or_its_texels_grow_too_far() {
     let (scene, field) = scene_field();
     let at = |x: f32, time_s: f32, sun: Vec3| BuiltShadow {
         params: ShadowParams::new(&scene, &field, Vec3::new(x, 30.0, 0.0), sun),
@@ -100,16 +100,21 @@ fn a_built_map_serves_until_the_eye_and_the_clouds_drift_too_far() {
         "{} {texel_m}",
         texel(128)
     );
-    let reuse = LightingReuse {
-        max_shadow_drift_texels: 0.5,
-    };
+    let reuse = LightingReuse::REAL_TIME;
     let wind = Vec2::new(6.0, 8.0);
     let served = |fresh: BuiltShadow| built.serves(&fresh, wind, reuse);
-    assert!(served(at(0.2 * texel_m, 0.0, sun())));
-    assert!(!served(at(0.6 * texel_m, 0.0, sun())));
+    // The eye may move until the texel under it is a quarter larger than the finest: at texel
+    // coordinate s = 0.125 k / (1 - k), offset s (k + (1 - k) s) half extents.
+    let k = built.params.warp;
+    let s = 0.125 * k / (1.0 - k);
+    let grown_m = s * (k + (1.0 - k) * s) * built.params.half_extent_m;
+    assert!(grown_m > 4.0 * texel_m, "{grown_m} m");
+    assert!(served(at(0.95 * grown_m, 0.0, sun())));
+    assert!(!served(at(1.05 * grown_m, 0.0, sun())));
+    // The clouds' shadows may lag half the finest texel.
     let half_texel_s = 0.5 * texel_m / 10.0;
     assert!(served(at(0.0, 0.9 * half_texel_s, sun())));
-    assert!(!served(at(0.3 * texel_m, 0.5 * half_texel_s, sun())));
+    assert!(!served(at(0.0, 1.1 * half_texel_s, sun())));
     assert!(!served(at(0.0, 0.0, Vec3::Y)));
     // A sun that moves shifts the highest clouds' shadows by its slope's change times their height.
     let span_m = built.params.top_y_m - built.params.bottom_y_m.min(0.0);
@@ -120,7 +125,17 @@ fn a_built_map_serves_until_the_eye_and_the_clouds_drift_too_far() {
     };
     assert!(served(at(0.0, 0.0, tilted(0.4 * texel_m))));
     assert!(!served(at(0.0, 0.0, tilted(0.6 * texel_m))));
-    assert!(!served(at(0.3 * texel_m, 0.0, tilted(0.3 * texel_m))));
+    assert!(!served(at(0.0, 0.6 * half_texel_s, tilted(0.3 * texel_m))));
+    // Without a warp the texels never grow: the eye may move a fiftieth of the map's reach.
+    let mut even = scene.clone();
+    even.shadow.warp = 1.0;
+    let even_at = |x: f32| BuiltShadow {
+        params: ShadowParams::new(&even, &field, Vec3::new(x, 30.0, 0.0), sun()),
+        ..built
+    };
+    let reach_m = even_at(0.0).params.half_extent_m;
+    assert!(even_at(0.0).serves(&even_at(0.019 * reach_m), wind, reuse));
+    assert!(!even_at(0.0).serves(&even_at(0.021 * reach_m), wind, reuse));
     assert!(!served(BuiltShadow {
         texels: 128,
         ..built
