@@ -83,7 +83,10 @@ impl ShadowParams {
     /// `k`.
     pub fn texel_growth_at(&self, g: Vec2) -> f32 {
         let offset = (g - self.centre_m) / self.half_extent_m;
-        let s = self.coord_of(offset.x).abs().max(self.coord_of(offset.y).abs());
+        let s = self
+            .coord_of(offset.x)
+            .abs()
+            .max(self.coord_of(offset.y).abs());
         (self.warp + 2.0 * (1.0 - self.warp) * s) / self.warp
     }
 

@@ -15,9 +15,27 @@
 // LIGHT_VOLUME_ROW_TEXELS for the copy into the 3-D texture: I0 of each cascade side by side along
 // z, then J / I0 the same way, then the ground's irradiance under each column in the bottom row.
 @group(3) @binding(3) var<storage, read_write> volume_table_out: array<vec2<u32>>;
-// Per cascade (xy): where this frame's cells lay in the grid the radiance was solved on, in whole
-// cells along x and z (LightVolumeGrid::shift_cells_from); read by light_volume_scroll only.
-@group(3) @binding(4) var<uniform> volume_shift_cells: array<vec4<i32>, LIGHT_VOLUME_MAX_CASCADES>;
+// What this frame's passes solve (light_volume::pass::SolveUniform).
+struct LightVolumeSolve {
+    shift_cells: array<vec4<i32>, LIGHT_VOLUME_MAX_CASCADES>, // xy: where this frame's cells lay in the grid last solved, in whole cells along x and z
+    first_swept: u32,                                         // the first cascade the sweeps and the table cover
+    swept: u32,                                               // how many, from it
+    pad0: u32,
+    pad1: u32,
+}
+@group(3) @binding(4) var<uniform> volume_solve: LightVolumeSolve;
+
+// The cell and cascade of an invocation of a dispatch over the cells of the cascades swept this
+// frame (x, the rest): a warm frame sweeps one cascade, in turn, and its dispatches cover that
+// cascade alone.
+fn light_volume_swept_cell_of(id: vec2<u32>) -> vec4<u32> {
+    return light_volume_cell_of(id) + vec4<u32>(0u, 0u, 0u, volume_solve.first_swept);
+}
+
+fn light_volume_in_swept_cells(id: vec2<u32>) -> bool {
+    let n = light_volume_cells_of();
+    return id.x < n.x && id.y < n.y * n.z * volume_solve.swept;
+}
 
 const LIGHT_VOLUME_LUMINANCE = vec3<f32>(0.2126, 0.7152, 0.0722);
 
@@ -136,11 +154,11 @@ fn light_volume_gradient(c: vec3<u32>, k: u32) -> vec4<f32> {
 // the brightest cell it reads (Diffusion::limited_diffusion).
 @compute @workgroup_size(8, 8)
 fn light_volume_limit(@builtin(global_invocation_id) id: vec3<u32>) {
-    if !light_volume_in_cells(id.xy) {
+    if !light_volume_in_swept_cells(id.xy) {
         return;
     }
     let v = environment.light_volume;
-    let ck = light_volume_cell_of(id.xy);
+    let ck = light_volume_swept_cell_of(id.xy);
     let c = ck.xyz;
     let k = ck.w;
     let gradient = light_volume_gradient(c, k);
@@ -270,14 +288,14 @@ fn light_volume_relax_column(x: u32, z: u32, k: u32, coupled: bool) {
     }
 }
 
-// Relaxes the columns of one colour ((x + z) % 2 == colour) of every cascade.
+// Relaxes the columns of one colour ((x + z) % 2 == colour) of every cascade swept.
 fn light_volume_relax(id: vec2<u32>, colour: u32, coupled: bool) {
     let n = light_volume_cells_of();
-    if id.x >= n.x || id.y >= n.z * environment.light_volume.cascades {
+    if id.x >= n.x || id.y >= n.z * volume_solve.swept {
         return;
     }
     let z = id.y % n.z;
-    let k = id.y / n.z;
+    let k = id.y / n.z + volume_solve.first_swept;
     if (id.x + z) % 2u != colour {
         return;
     }
@@ -336,11 +354,11 @@ fn light_volume_weight(extinction: f32, h: vec3<f32>) -> f32 {
 // holds, so that filtering interpolates them weighted.
 @compute @workgroup_size(8, 8)
 fn light_volume_export(@builtin(global_invocation_id) id: vec3<u32>) {
-    if !light_volume_in_cells(id.xy) {
+    if !light_volume_in_swept_cells(id.xy) {
         return;
     }
     let v = environment.light_volume;
-    let ck = light_volume_cell_of(id.xy);
+    let ck = light_volume_swept_cell_of(id.xy);
     let c = ck.xyz;
     let k = ck.w;
     let i = light_volume_index(c, k);
@@ -383,7 +401,7 @@ fn light_volume_scroll(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let c = light_volume_cell_of(id.xy);
     let last = vec2<i32>(light_volume_cells_of().xz) - 1;
-    let at = clamp(vec2<i32>(c.xz) + volume_shift_cells[c.w].xy, vec2<i32>(0), last);
+    let at = clamp(vec2<i32>(c.xz) + volume_solve.shift_cells[c.w].xy, vec2<i32>(0), last);
     let texel = 2u * light_volume_index(vec3<u32>(u32(at.x), c.y, u32(at.y)), c.w);
     let radiance = vec4<f32>(bitcast<vec2<f32>>(volume_table_out[texel]), bitcast<vec2<f32>>(volume_table_out[texel + 1u]));
     volume_radiance[light_volume_index(c.xyz, c.w)] = radiance;

@@ -92,7 +92,7 @@ pub struct LightVolumeSettings {
     pub cascades: u32,
     /// Sweeps of a cold start (the grid new or moved).
     pub sweeps: u32,
-    /// Sweeps per frame once warm.
+    /// Sweeps a warm frame gives the one cascade it solves (the cascades take turns).
     pub warm_sweeps: u32,
     /// Samples of the mean field toward the sun per cell.
     pub beam_steps: u32,

@@ -8,6 +8,7 @@ use crate::environment::{EnvironmentGpu, EnvironmentTable};
 use crate::gpu::pipeline::{storage_buffer, uniform_buffer};
 use crate::gpu::{GpuContext, PassTimer};
 use crate::pass::{BindGroupCache, ComputePass, Shared};
+use bytemuck::{Pod, Zeroable};
 use glam::{IVec4, UVec2};
 
 /// Labels the passes are timed under: the cells' inputs, the solve's sweeps, the table.
@@ -43,8 +44,10 @@ const ROW_TEXELS: u32 = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT / 8;
 pub struct LightVolumePass {
     pass: ComputePass,
     buffers: Option<[wgpu::Buffer; 4]>,
-    /// Per cascade, how far a recentred grid's cells moved (`volume_shift_cells`).
-    shift: wgpu::Buffer,
+    /// What the frame's passes solve ([`SolveUniform`]).
+    solve: wgpu::Buffer,
+    /// Warm frames solved since the last cold or scrolled one: whose turn it is.
+    warm_frames: u32,
     group: BindGroupCache,
     solved: Option<LightVolumeGrid>,
 }
@@ -55,7 +58,8 @@ impl LightVolumePass {
         LightVolumePass {
             pass: ComputePass::new(ctx, shared, "light volume", &LIGHT_VOLUME_WGSL, &ENTRIES),
             buffers: None,
-            shift: uniform_buffer(ctx, "light volume shift", 16 * u64::from(MAX_CASCADES)),
+            solve: uniform_buffer(ctx, "light volume solve", size_of::<SolveUniform>() as u64),
+            warm_frames: 0,
             group: BindGroupCache::default(),
             solved: None,
         }
@@ -90,7 +94,8 @@ impl LightVolumePass {
     /// solve of `settings.sweeps` sweeps when the grid is new or the frame may not start warm;
     /// when the grid was recentred by whole cells, the last solution scrolled with it, every
     /// cell's inputs and `warm_sweeps` more sweeps than it moved cells (the solution spreads a
-    /// cell a sweep into the new columns); else `warm_sweeps` from the last solution.
+    /// cell a sweep into the new columns); else, amortised over frames, `warm_sweeps` of one
+    /// cascade from the last solution, each cascade in turn, and a slice of the cells' inputs.
     pub fn encode(
         &mut self,
         ctx: &GpuContext,
@@ -113,6 +118,20 @@ impl LightVolumePass {
             let most = s.iter().map(|c| c.abs().max_element()).max();
             most.unwrap_or(0) as u32
         });
+        let mut solve = SolveUniform::zeroed();
+        for (c, s) in solve.shift_cells.iter_mut().zip(shift.iter().flatten()) {
+            *c = s.extend(0).extend(0);
+        }
+        (solve.first_swept, solve.swept) = match moved_cells {
+            Some(0) => (self.warm_frames % cascades, 1),
+            _ => (0, cascades),
+        };
+        self.warm_frames = match moved_cells {
+            Some(0) => self.warm_frames.wrapping_add(1),
+            _ => 0,
+        };
+        ctx.queue
+            .write_buffer(&self.solve, 0, bytemuck::bytes_of(&solve));
         let buffers = self.buffers.as_ref().expect("made above");
         let n = grid.cells;
         let over_cells = UVec2::new(n.x, n.y * n.z * cascades);
@@ -127,18 +146,12 @@ impl LightVolumePass {
                 UVec2::new(n.x, over_cells.y.div_ceil(CELL_SLICES)),
             )),
             Some(_) => {
-                let mut cells = [IVec4::ZERO; MAX_CASCADES as usize];
-                for (c, s) in cells.iter_mut().zip(shift.iter().flatten()) {
-                    *c = s.extend(0).extend(0);
-                }
-                ctx.queue
-                    .write_buffer(&self.shift, 0, bytemuck::cast_slice(&cells));
                 encoder.copy_buffer_to_buffer(&buffers[1], 0, &buffers[3], 0, buffers[1].size());
                 first.extend([(ENTRIES[8], over_cells), (ENTRIES[0], over_cells)]);
             }
         }
         let pass = &self.pass;
-        let shift_buffer = &self.shift;
+        let solve_buffer = &self.solve;
         let group = self.group.get(&[], || {
             pass.group.bind(
                 ctx,
@@ -147,13 +160,14 @@ impl LightVolumePass {
                     ("volume_radiance", buffers[1].as_entire_binding()),
                     ("volume_diffusion", buffers[2].as_entire_binding()),
                     ("volume_table_out", buffers[3].as_entire_binding()),
-                    ("volume_shift_cells", shift_buffer.as_entire_binding()),
+                    ("volume_solve", solve_buffer.as_entire_binding()),
                 ],
             )
         });
         let writing = environment.bind_group_writing(EnvironmentTable::LightVolume);
         let groups = shared.bind_groups_with(pass.slots, writing, group);
-        let over_columns = UVec2::new(n.x, n.z * cascades);
+        let over_swept_cells = UVec2::new(n.x, n.y * n.z * solve.swept);
+        let over_columns = UVec2::new(n.x, n.z * solve.swept);
         let sweeps = match moved_cells {
             None => settings.sweeps.max(1),
             Some(moved) => (settings.warm_sweeps + moved).min(settings.sweeps.max(1)),
@@ -161,7 +175,7 @@ impl LightVolumePass {
         let mut steps = Vec::new();
         for s in 0..sweeps {
             let coupled = !(moved_cells.is_none() && s == 0);
-            steps.push((ENTRIES[2], over_cells));
+            steps.push((ENTRIES[2], over_swept_cells));
             let (red, black) = if coupled { (3, 4) } else { (5, 6) };
             steps.push((ENTRIES[red], over_columns));
             steps.push((ENTRIES[black], over_columns));
@@ -187,7 +201,7 @@ impl LightVolumePass {
         };
         record(cells_name, &first);
         record(solve_name, &steps);
-        record(table_name, &[(ENTRIES[7], over_cells)]);
+        record(table_name, &[(ENTRIES[7], over_swept_cells)]);
         copy_table(
             encoder,
             &buffers[3],
@@ -196,6 +210,21 @@ impl LightVolumePass {
         );
         self.solved = Some(grid.clone());
     }
+}
+
+/// What a frame's passes solve: `LightVolumeSolve` of `light_volume.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct SolveUniform {
+    /// Per cascade (x, y): where the frame's cells lay in the grid last solved, in whole cells
+    /// along x and z ([`LightVolumeGrid::shift_cells_from`]), for a recentred grid's scroll.
+    shift_cells: [IVec4; MAX_CASCADES as usize],
+    /// The first cascade the frame's sweeps and table cover.
+    first_swept: u32,
+    /// How many cascades, from it.
+    swept: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 /// Texels of a row of the staged table for `width` cells: padded to [`ROW_TEXELS`].
@@ -263,4 +292,25 @@ fn light_volume_constants() -> String {
             F32(super::read::MIN_INTERPOLATION_WEIGHT),
         ),
     ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::layout_check::assert_wgsl_layout;
+
+    #[test]
+    fn the_solve_uniform_matches_its_wgsl_layout() {
+        assert_wgsl_layout!(
+            &LIGHT_VOLUME_WGSL,
+            "LightVolumeSolve",
+            SolveUniform {
+                shift_cells,
+                first_swept,
+                swept,
+                pad0,
+                pad1
+            }
+        );
+    }
 }
