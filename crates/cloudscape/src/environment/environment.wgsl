@@ -12,8 +12,8 @@ struct LightVolume {
     optics: vec4<f32>,         // DiffuseOptics::to_gpu: scaled albedo, scaled g, thinning, g
     enabled: u32,              // 0: no clouds, the volume reads zero
     beam_steps: u32,           // samples of the coarse field toward the sun per cell
-    cell_slice: u32,           // the slice of the cells' rows a warm frame updates
-    pad: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 struct Environment {

@@ -134,8 +134,8 @@ pub struct LightVolumeUniform {
     optics: Vec4,
     enabled: u32,
     beam_steps: u32,
-    cell_slice: u32,
-    pad: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 impl LightVolumeUniform {
@@ -158,15 +158,6 @@ impl LightVolumeUniform {
         out.enabled = u32::from(grid.enabled);
         out.beam_steps = beam_steps;
         out
-    }
-
-    /// The same volume, updating the cells' inputs of slice `slice` (of
-    /// [`crate::environment::light_volume::CELL_SLICES`]) on a warm frame.
-    pub fn with_cell_slice(self, slice: u32) -> LightVolumeUniform {
-        LightVolumeUniform {
-            cell_slice: slice,
-            ..self
-        }
     }
 }
 
@@ -609,8 +600,8 @@ mod tests {
                 optics,
                 enabled,
                 beam_steps,
-                cell_slice,
-                pad,
+                pad0,
+                pad1,
             }
         );
         assert_wgsl_layout!(

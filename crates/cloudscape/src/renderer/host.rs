@@ -10,9 +10,7 @@
 //! statistics come back a frame late ([`CloudRenderer::stats`]).
 
 use super::dispatch;
-use crate::environment::light_volume::{
-    CELL_SLICES, DiffuseOptics, LightVolumeGrid, LightVolumeSettings,
-};
+use crate::environment::light_volume::{DiffuseOptics, LightVolumeGrid, LightVolumeSettings};
 use crate::environment::{
     CloudShadowUniform, Environment, EnvironmentGpu, EnvironmentPasses, EnvironmentTable,
     EnvironmentUniform, LightVolumeUniform, ShadowMapBinding, Sky, TableSizes,
@@ -134,8 +132,6 @@ pub struct CloudRenderer {
     technique_setup_pending: bool,
     /// CPU time the technique took to take the last frame begun ([`Technique::prepare`]).
     prepare_time: std::time::Duration,
-    /// Frames begun: picks the slice of the light volume's cells a warm frame updates.
-    frames_begun: u32,
     technique: Box<dyn Technique>,
     temporal: Option<TemporalResolve>,
     upsampler: Upsampler,
@@ -190,7 +186,6 @@ impl CloudRenderer {
             environment: (Environment::from_scene(scene), false),
             technique_setup_pending: false,
             prepare_time: std::time::Duration::ZERO,
-            frames_begun: 0,
             technique,
             temporal: None,
             upsampler,
@@ -380,7 +375,6 @@ impl CloudRenderer {
         let shadow = self.frame_shadow(&env, frame);
         self.environment_gpu
             .resize(ctx, TableSizes::from_scene(&self.settings));
-        self.frames_begun = self.frames_begun.wrapping_add(1);
         let warm = matches!(reuse, Reuse::Temporal(_)) || self.lighting_reuse.is_some();
         let kept = self
             .light_volume
@@ -453,7 +447,6 @@ impl CloudRenderer {
         LightVolumeUniform::new(
             volume.map(|(grid, settings, _)| (grid, optics, settings.beam_steps)),
         )
-        .with_cell_slice(self.frames_begun % CELL_SLICES)
     }
 
     /// The wind of the first layer, which carries the clouds (zero without layers).

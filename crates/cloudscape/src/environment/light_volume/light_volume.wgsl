@@ -20,8 +20,8 @@ struct LightVolumeSolve {
     shift_cells: array<vec4<i32>, LIGHT_VOLUME_MAX_CASCADES>, // xy: where this frame's cells lay in the grid last solved, in whole cells along x and z
     first_swept: u32,                                         // the first cascade the sweeps and the table cover
     swept: u32,                                               // how many, from it
+    cell_slice: u32,                                          // the slice of the swept cells' rows a warm frame updates
     pad0: u32,
-    pad1: u32,
 }
 @group(3) @binding(4) var<uniform> volume_solve: LightVolumeSolve;
 
@@ -74,13 +74,17 @@ fn light_volume_cells(@builtin(global_invocation_id) id: vec3<u32>) {
     light_volume_cell_inputs(id.xy);
 }
 
-// The cells' inputs of one slice of the rows: every LIGHT_VOLUME_CELL_SLICES-th, from the frame's
-// cell_slice. A warm frame updates one slice and keeps the others' inputs from the last frames
-// (a few frames old: the clouds move 0.13 m a frame at 60 fps in an 8 m/s wind).
+// The cells' inputs of one slice of the swept cascade's rows: every LIGHT_VOLUME_CELL_SLICES-th,
+// from the frame's cell_slice. A warm frame updates one slice and keeps the others' inputs from
+// the last frames (a few frames old: the clouds move 0.13 m a frame at 60 fps in an 8 m/s wind).
 @compute @workgroup_size(8, 8)
 fn light_volume_cells_slice(@builtin(global_invocation_id) id: vec3<u32>) {
-    let row = id.y * LIGHT_VOLUME_CELL_SLICES + environment.light_volume.cell_slice;
-    light_volume_cell_inputs(vec2<u32>(id.x, row));
+    let n = light_volume_cells_of();
+    let row = id.y * LIGHT_VOLUME_CELL_SLICES + volume_solve.cell_slice;
+    if row >= n.y * n.z * volume_solve.swept {
+        return;
+    }
+    light_volume_cell_inputs(vec2<u32>(id.x, row + n.y * n.z * volume_solve.first_swept));
 }
 
 fn light_volume_cell_inputs(id: vec2<u32>) {

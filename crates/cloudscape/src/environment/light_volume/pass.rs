@@ -30,8 +30,10 @@ const ENTRIES: [&str; 9] = [
     "light_volume_scroll",
 ];
 
-/// Slices the cells' rows are updated in on warm frames, one a frame: a warm frame recomputes the
-/// inputs (the mean field's extinction, the sun's beam through it) of a quarter of the cells.
+/// Slices a cascade's rows are updated in on warm frames, one a turn: a warm frame recomputes the
+/// inputs (the mean field's extinction, the sun's beam through it) of a quarter of the cells of
+/// the cascade it solves, so that a cell's inputs are at most `CELL_SLICES` times the cascades
+/// frames old (8 in the default scene: the clouds move 1 m in that time at 60 fps).
 pub const CELL_SLICES: u32 = 4;
 
 /// Texels a row of the table's staging buffer is padded to: wgpu copies rows of 256 bytes
@@ -126,6 +128,7 @@ impl LightVolumePass {
             Some(0) => (self.warm_frames % cascades, 1),
             _ => (0, cascades),
         };
+        solve.cell_slice = (self.warm_frames / cascades) % CELL_SLICES;
         self.warm_frames = match moved_cells {
             Some(0) => self.warm_frames.wrapping_add(1),
             _ => 0,
@@ -143,7 +146,7 @@ impl LightVolumePass {
             }
             Some(0) => first.push((
                 ENTRIES[1],
-                UVec2::new(n.x, over_cells.y.div_ceil(CELL_SLICES)),
+                UVec2::new(n.x, (n.y * n.z).div_ceil(CELL_SLICES)),
             )),
             Some(_) => {
                 encoder.copy_buffer_to_buffer(&buffers[1], 0, &buffers[3], 0, buffers[1].size());
@@ -204,9 +207,12 @@ impl LightVolumePass {
         record(table_name, &[(ENTRIES[7], over_swept_cells)]);
         copy_table(
             encoder,
-            &buffers[3],
-            environment.texture(EnvironmentTable::LightVolume),
+            (
+                &buffers[3],
+                environment.texture(EnvironmentTable::LightVolume),
+            ),
             grid,
+            &solve,
         );
         self.solved = Some(grid.clone());
     }
@@ -223,8 +229,9 @@ struct SolveUniform {
     first_swept: u32,
     /// How many cascades, from it.
     swept: u32,
+    /// The slice of the swept cascades' rows whose inputs a warm frame updates.
+    cell_slice: u32,
     pad0: u32,
-    pad1: u32,
 }
 
 /// Texels of a row of the staged table for `width` cells: padded to [`ROW_TEXELS`].
@@ -232,31 +239,41 @@ fn table_row_texels(width: u32) -> u32 {
     width.div_ceil(ROW_TEXELS) * ROW_TEXELS
 }
 
-/// Copies the staged table into the environment's texture ([`TABLE_PARTS`] along z).
+/// Copies the parts of the swept cascades (`solve`'s) of the staged table into the environment's
+/// texture: the table holds [`TABLE_PARTS`] parts along z, each the cascades' cells side by side.
 fn copy_table(
     encoder: &mut wgpu::CommandEncoder,
-    staged: &wgpu::Buffer,
-    texture: &wgpu::Texture,
+    (staged, texture): (&wgpu::Buffer, &wgpu::Texture),
     grid: &LightVolumeGrid,
+    solve: &SolveUniform,
 ) {
     let n = grid.cells;
-    let slices = TABLE_PARTS * n.z * grid.cascades.len() as u32;
-    encoder.copy_buffer_to_texture(
-        wgpu::TexelCopyBufferInfo {
-            buffer: staged,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(8 * table_row_texels(n.x)),
-                rows_per_image: Some(n.y),
+    let bytes_per_row = 8 * table_row_texels(n.x);
+    for part in 0..TABLE_PARTS {
+        let first_slice = n.z * (part * grid.cascades.len() as u32 + solve.first_swept);
+        encoder.copy_buffer_to_texture(
+            wgpu::TexelCopyBufferInfo {
+                buffer: staged,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: u64::from(first_slice * n.y * bytes_per_row),
+                    bytes_per_row: Some(bytes_per_row),
+                    rows_per_image: Some(n.y),
+                },
             },
-        },
-        texture.as_image_copy(),
-        wgpu::Extent3d {
-            width: n.x,
-            height: n.y,
-            depth_or_array_layers: slices,
-        },
-    );
+            wgpu::TexelCopyTextureInfo {
+                origin: wgpu::Origin3d {
+                    z: first_slice,
+                    ..wgpu::Origin3d::ZERO
+                },
+                ..texture.as_image_copy()
+            },
+            wgpu::Extent3d {
+                width: n.x,
+                height: n.y,
+                depth_or_array_layers: n.z * solve.swept,
+            },
+        );
+    }
 }
 
 /// The light volume's solve on the GPU (`light_volume.wgsl`).
@@ -308,8 +325,8 @@ mod tests {
                 shift_cells,
                 first_swept,
                 swept,
-                pad0,
-                pad1
+                cell_slice,
+                pad0
             }
         );
     }
