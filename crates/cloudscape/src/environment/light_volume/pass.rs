@@ -36,6 +36,13 @@ const ENTRIES: [&str; 9] = [
 /// frames old (8 in the default scene: the clouds move 1 m in that time at 60 fps).
 pub const CELL_SLICES: u32 = 4;
 
+/// The most cells (of any cascade) a recentred grid may have moved for its solve to start from the
+/// last solution scrolled: twice [`super::RECENTRE_CELLS`] (in the default scene 2.7 km, a frame's
+/// move at 160 km/s and 60 fps), more than any flight recentres it by. A grid that moved further was
+/// cut to a new place (a camera cut, a teleport) and is solved cold, as a first frame there would
+/// be: nothing of before leaks in.
+const MAX_SCROLL_CELLS: u32 = 2 * super::RECENTRE_CELLS as u32;
+
 /// Texels a row of the table's staging buffer is padded to: wgpu copies rows of 256 bytes
 /// (`COPY_BYTES_PER_ROW_ALIGNMENT`), 32 rgba16float texels.
 const ROW_TEXELS: u32 = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT / 8;
@@ -116,12 +123,13 @@ impl LightVolumePass {
             (Some(solved), false) => grid.shift_cells_from(solved),
             _ => None,
         };
-        let moved_cells = shift.as_ref().map(|s| {
-            let most = s.iter().map(|c| c.abs().max_element()).max();
-            most.unwrap_or(0) as u32
-        });
+        let moved_cells = shift
+            .as_ref()
+            .map(|s| s.iter().map(|c| c.abs().max_element()).max().unwrap_or(0) as u32)
+            .filter(|&moved| moved <= MAX_SCROLL_CELLS);
         let mut solve = SolveUniform::zeroed();
-        for (c, s) in solve.shift_cells.iter_mut().zip(shift.iter().flatten()) {
+        let scrolled = shift.iter().flatten().filter(|_| moved_cells.is_some());
+        for (c, s) in solve.shift_cells.iter_mut().zip(scrolled) {
             *c = s.extend(0).extend(0);
         }
         (solve.first_swept, solve.swept) = match moved_cells {
