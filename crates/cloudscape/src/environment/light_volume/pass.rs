@@ -119,28 +119,7 @@ impl LightVolumePass {
         );
         let cascades = grid.cascades.len() as u32;
         let remade = self.ensure_buffers(ctx, grid);
-        let shift = match (&self.solved, remade || !may_start_warm) {
-            (Some(solved), false) => grid.shift_cells_from(solved),
-            _ => None,
-        };
-        let moved_cells = shift
-            .as_ref()
-            .map(|s| s.iter().map(|c| c.abs().max_element()).max().unwrap_or(0) as u32)
-            .filter(|&moved| moved <= MAX_SCROLL_CELLS);
-        let mut solve = SolveUniform::zeroed();
-        let scrolled = shift.iter().flatten().filter(|_| moved_cells.is_some());
-        for (c, s) in solve.shift_cells.iter_mut().zip(scrolled) {
-            *c = s.extend(0).extend(0);
-        }
-        (solve.first_swept, solve.swept) = match moved_cells {
-            Some(0) => (self.warm_frames % cascades, 1),
-            _ => (0, cascades),
-        };
-        solve.cell_slice = (self.warm_frames / cascades) % CELL_SLICES;
-        self.warm_frames = match moved_cells {
-            Some(0) => self.warm_frames.wrapping_add(1),
-            _ => 0,
-        };
+        let (solve, moved_cells) = self.plan(grid, !remade && may_start_warm);
         ctx.queue
             .write_buffer(&self.solve, 0, bytemuck::bytes_of(&solve));
         let buffers = self.buffers.as_ref().expect("made above");
@@ -223,6 +202,42 @@ impl LightVolumePass {
             &solve,
         );
         self.solved = Some(grid.clone());
+    }
+}
+
+impl LightVolumePass {
+    /// What this frame solves for `grid`, and how many cells the grid moved since the last
+    /// solution when the solve starts from it (None: cold; 0: a warm frame, which takes the next
+    /// cascade's turn).
+    fn plan(
+        &mut self,
+        grid: &LightVolumeGrid,
+        may_start_warm: bool,
+    ) -> (SolveUniform, Option<u32>) {
+        let cascades = grid.cascades.len() as u32;
+        let shift = match (&self.solved, may_start_warm) {
+            (Some(solved), true) => grid.shift_cells_from(solved),
+            _ => None,
+        };
+        let moved_cells = shift
+            .as_ref()
+            .map(|s| s.iter().map(|c| c.abs().max_element()).max().unwrap_or(0) as u32)
+            .filter(|&moved| moved <= MAX_SCROLL_CELLS);
+        let mut solve = SolveUniform::zeroed();
+        let scrolled = shift.iter().flatten().filter(|_| moved_cells.is_some());
+        for (c, s) in solve.shift_cells.iter_mut().zip(scrolled) {
+            *c = s.extend(0).extend(0);
+        }
+        (solve.first_swept, solve.swept) = match moved_cells {
+            Some(0) => (self.warm_frames % cascades, 1),
+            _ => (0, cascades),
+        };
+        solve.cell_slice = (self.warm_frames / cascades) % CELL_SLICES;
+        self.warm_frames = match moved_cells {
+            Some(0) => self.warm_frames.wrapping_add(1),
+            _ => 0,
+        };
+        (solve, moved_cells)
     }
 }
 
