@@ -1,13 +1,13 @@
 //! Every WGSL function with a CPU twin agrees with it on the GPU: the coarse field the light paths
 //! use (and the sprites read in one batch), camera rays and depth in every convention, aerial
 //! perspective, the sun disc, the sky, the ground, the diffuse transmittance, phase functions,
-//! height profiles and tone mapping. Also: a live edit of the field reaches the GPU without
+//! height profiles, tone mapping and the half-float rounding of the temporal history. Also: a live edit of the field reaches the GPU without
 //! regenerating the noise.
 
 use cloudscape::environment::{Environment, ViewedEnvironment};
 use cloudscape::field::read_gpu::FieldReadPass;
 use cloudscape::field::{CoarseFieldReader, CpuCoarseReader};
-use cloudscape::frame::{DepthConvention, Frame, FrameSettings};
+use cloudscape::frame::{DepthConvention, Frame, FrameSettings, round_to_half};
 use cloudscape::gpu::GpuContext;
 use cloudscape::optics::{
     Octaves, PhaseLobes, SunSlab, diffuse_transmittance, two_stream_share_from_below,
@@ -595,6 +595,27 @@ fn the_cloud_shadow_map_matches_the_cpu() {
         points.iter().filter(|p| sun_depth(**p).x > 1.0).count() > 20,
         "clouds cast shadows"
     );
+}
+
+#[test]
+fn half_float_rounding_matches_the_cpu() {
+    let ctx = GpuContext::for_tests();
+    let scene = Scene::default();
+    let clouds = renderer(&ctx, &scene, &Frame::from_scene(&scene, SIZE));
+    let inputs: Vec<ProbeInput> = (0..400)
+        .map(|i| {
+            let magnitude = 10f32.powf(-7.0 + 11.5 * unit(i, 30)); // up to 3e4: a half float's range
+            let value = Vec4::new(magnitude, -magnitude, unit(i, 31), 0.0);
+            input(value, Vec4::splat(unit(i, 32)))
+        })
+        .collect();
+    let got = gpu(&ctx, &clouds, ProbeFunction::RoundToHalf, &inputs);
+    for (g, i) in got.iter().zip(&inputs) {
+        let want = i.a.map(|v| round_to_half(v, i.b.x));
+        assert_eq!(*g, want, "{} at u = {}", i.a, i.b.x);
+        let held = g.to_array().map(|v| half::f16::from_f32(v).to_f32());
+        assert_eq!(g.to_array(), held, "{g} is not a half float");
+    }
 }
 
 /// A CPU tone-mapping function.

@@ -3,8 +3,8 @@
 
 use cloudscape::frame::Frame;
 use cloudscape::gpu::{GpuContext, PassTimer};
-use cloudscape::image::{LdrImage, flip};
-use cloudscape::renderer::{PASS_COUNT, Reuse, SceneRenderer};
+use cloudscape::image::{HdrImage, LdrImage, flip};
+use cloudscape::renderer::{PASS_COUNT, Rendered, Reuse, SceneRenderer};
 use cloudscape::scene::{Scene, SceneDocument};
 use cloudscape::temporal::TemporalSettings;
 use glam::{UVec2, Vec3};
@@ -57,6 +57,10 @@ impl Sequence {
     }
 
     fn frame(&mut self, ctx: &GpuContext, scene: &Scene, camera: Vec3) -> LdrImage {
+        self.rendered(ctx, scene, camera).ldr
+    }
+
+    fn rendered(&mut self, ctx: &GpuContext, scene: &Scene, camera: Vec3) -> Rendered {
         let mut s = scene.clone();
         s.camera.position_m = camera.to_array();
         let mut frame = Frame::from_scene(&s, SIZE);
@@ -64,7 +68,7 @@ impl Sequence {
         self.index += 1;
         self.renderer
             .render_frame(ctx, &frame, self.reuse, &mut self.timer);
-        self.renderer.images(ctx).ldr
+        self.renderer.images(ctx)
     }
 }
 
@@ -106,6 +110,45 @@ fn converges_on_a_still_view_and_recovers_after_a_fast_move() {
     assert!(
         after < settled * 1.5 + 0.01,
         "ghosts must fade within 8 frames: {after} vs settled {settled}"
+    );
+}
+
+/// Mean luminance (Rec. 709) of an HDR image.
+fn mean_luminance(image: &HdrImage) -> f64 {
+    let sum: f64 = (image.pixels.iter())
+        .map(|[r, g, b, _]| f64::from(0.2126 * r + 0.7152 * g + 0.0722 * b))
+        .sum();
+    sum / image.pixels.len() as f64
+}
+
+#[test]
+fn a_still_history_settles_on_the_mean_of_its_own_march() {
+    let ctx = GpuContext::for_tests();
+    let scene = scene();
+    let camera = Vec3::from_array(scene.camera.position_m);
+    // One ray per pixel per frame: every pixel's history is a running mean with a weight of 0.05
+    // a frame, whose updates are a small part of a half float's step on bright clouds.
+    let mut temporal = Sequence::new(&ctx, &scene, 1);
+    let mut settled = 0.0;
+    for _ in 0..64 {
+        settled = mean_luminance(&temporal.rendered(&ctx, &scene, camera).hdr);
+    }
+    let mut full = Sequence::new(&ctx, &scene, 1);
+    full.reuse = Reuse::None;
+    let frames = 8;
+    let marched = (0..frames)
+        .map(|_| mean_luminance(&full.rendered(&ctx, &scene, camera).hdr))
+        .sum::<f64>()
+        / f64::from(frames);
+    let drift = settled / marched - 1.0;
+    eprintln!(
+        "still history against its march's mean: {:+.4} %",
+        100.0 * drift
+    );
+    assert!(
+        drift.abs() < 5.0e-4,
+        "the history settles {:+.4} % off its own march's mean",
+        100.0 * drift
     );
 }
 

@@ -98,6 +98,22 @@ fn frame_blue_noise(pixel: vec2<u32>, index: u32) -> f32 {
     return fract(spatial + f32(index % 4096u) * FRAME_OFFSET_STEP);
 }
 
+// v rounded to a value a half float holds: up or down at random, with the probabilities that keep
+// its expectation (stochastic rounding: Forsythe 1959, "Reprint of a note on rounding-off errors",
+// SIAM Review 1; Connolly, Higham & Mary 2021, "Stochastic rounding and its probabilistic backward
+// error analysis", SIAM J. Sci. Comput. 43). For running means stored in half floats: rounded to
+// the nearest half (or toward zero, as a store may), every update smaller than half a unit in the
+// last place is lost, and a mean that began low stays low. `u` is uniform in [0, 1).
+// frame::round_to_half is the same.
+fn frame_round_to_half(v: vec4<f32>, u: f32) -> vec4<f32> {
+    let bits = bitcast<vec4<u32>>(abs(v));
+    // Each value's binary exponent, and a half float's unit in the last place there: 10 fraction
+    // bits, and below the normal range (2^-14) the subnormals' fixed unit 2^-24.
+    let exponent = max(vec4<i32>((bits >> vec4<u32>(23u)) & vec4<u32>(0xffu)) - 127, vec4<i32>(-14));
+    let ulp = exp2(vec4<f32>(exponent - 10));
+    return sign(v) * floor(abs(v) / ulp + u) * ulp;
+}
+
 // Eddington (two-stream) diffuse transmittance of a conservatively scattering slab of optical depth
 // tau: 1 / (1 + 3/4 (1 - g) tau) (e.g. Bohren 1987, "Multiple scattering of light and some of its
 // observable consequences", Am. J. Phys. 55): diffuse light is dimmed by the transport optical

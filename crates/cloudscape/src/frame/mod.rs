@@ -26,6 +26,20 @@ pub const FOOTPRINT_STEP: [f64; 2] = [0.754_877_666_246_692_7, 0.569_840_290_998
 /// sequence, the most even additive recurrence in one dimension (Roberts 2018).
 pub const FRAME_OFFSET_STEP: f64 = 0.618_033_988_749_894_9;
 
+/// `value` rounded to a value an IEEE half float holds, up or down with the probabilities that keep
+/// its expectation, by `u` uniform in [0, 1) (stochastic rounding: Forsythe 1959; Connolly, Higham
+/// & Mary 2021): a running mean stored in half floats (the temporal history) then drifts neither
+/// way by the rounding of its small updates. `frame_round_to_half` in `frame.wgsl` is the same.
+pub fn round_to_half(value: f32, u: f32) -> f32 {
+    /// Fraction bits of a half float.
+    const HALF_FRACTION_BITS: i32 = 10;
+    /// Exponent of a half float's smallest normal value.
+    const HALF_MIN_EXPONENT: i32 = -14;
+    let exponent = ((value.abs().to_bits() >> 23) & 0xff) as i32 - 127;
+    let ulp = 2f32.powi(exponent.max(HALF_MIN_EXPONENT) - HALF_FRACTION_BITS);
+    value.signum() * (value.abs() / ulp + u).floor() * ulp
+}
+
 /// Normalised device depth of the point `camera_ray` and `frame_ray_direction` unproject to find a
 /// pixel's ray: between the near and far planes in every [`DepthConvention`].
 const RAY_NDC_DEPTH: f32 = 0.5;
@@ -227,6 +241,39 @@ impl Frame {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn half_float_rounding_keeps_the_mean_and_lands_on_half_floats() {
+        let values = [
+            0.0, 1.0e-6, -3.0e-5, 0.1, 0.7431, -1.0, 1.0, 2.0e-3, 17.29, 1000.3, 6.0e4,
+        ];
+        for value in values {
+            let steps = 256;
+            let rounded: Vec<f32> = (0..steps)
+                .map(|i| round_to_half(value, (i as f32 + 0.5) / steps as f32))
+                .collect();
+            for r in &rounded {
+                assert_eq!(half::f16::from_f32(*r).to_f32(), *r, "{value} -> {r}");
+            }
+            let ulp = (half::f16::from_f32(value.abs()).to_f32() - value.abs())
+                .abs()
+                .max(1e-8);
+            let mean = rounded.iter().sum::<f32>() / steps as f32;
+            // The mean of the stratified roundings is the value itself, within a small part of
+            // the rounding step (nearest-rounding would be off by up to half of it).
+            let spacing = (rounded.iter().cloned().fold(f32::MIN, f32::max)
+                - rounded.iter().cloned().fold(f32::MAX, f32::min))
+            .max(ulp);
+            assert!(
+                (mean - value).abs() <= spacing / steps as f32 + value.abs() * 1e-6,
+                "{value}: mean {mean}"
+            );
+        }
+        // A value below half a unit of its half-float neighbours is not lost on average.
+        let small_step = 1.0 + 2f32.powi(-13);
+        let up = (0..64).filter(|i| round_to_half(small_step, (*i as f32 + 0.5) / 64.0) > 1.0);
+        assert_eq!(up.count(), 8, "1 + 1/8 ulp rounds up an eighth of the time");
+    }
 
     #[test]
     fn centre_ray_looks_where_the_camera_looks() {

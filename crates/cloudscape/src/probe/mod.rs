@@ -84,6 +84,8 @@ pub enum ProbeFunction {
     LightVolumeGroundIrradiance = 29,
     /// `phase_broad_share(lobes a, peak weight b.z, cos theta b.x)`: `PhaseLobes::broad_share`.
     PhaseBroadShare = 30,
+    /// `frame_round_to_half(a, u b.x)`: `frame::round_to_half`.
+    RoundToHalf = 31,
 }
 
 /// The inputs of one evaluation.

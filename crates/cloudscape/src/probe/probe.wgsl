@@ -55,6 +55,7 @@ fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>) ->
         case 28u: { return vec4<f32>(environment_light_volume_diffuse(a.xyz, b.xyz), 0.0); }
         case 29u: { return vec4<f32>(environment_light_volume_ground_irradiance(a.xyz), 0.0); }
         case 30u: { return vec4<f32>(phase_broad_share(a, b.z, b.x)); }
+        case 31u: { return frame_round_to_half(a, b.x); }
         default: { return vec4<f32>(-1.0); }
     }
 }

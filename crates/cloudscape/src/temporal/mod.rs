@@ -314,7 +314,11 @@ pub static UPSAMPLE_WGSL: crate::shader::WgslModule =
 pub static TEMPORAL_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
     "temporal",
     "temporal.wgsl",
-    [&crate::frame::FRAME_WGSL, &UPSAMPLE_WGSL],
+    [
+        &crate::frame::FRAME_WGSL,
+        &UPSAMPLE_WGSL,
+        &crate::field::noise::NOISE_WGSL
+    ],
     temporal_constants
 );
 
@@ -340,12 +344,17 @@ pub const MOVING_RAY_SIGMA_PX: f32 = 1.2;
 pub const CLIP_MOTION_PX: f32 = 2.0;
 
 /// The resolve's constants as WGSL.
+/// Seed of the white noise by which the history is rounded to half floats at random
+/// (`frame_round_to_half`), apart from every other hash of the pixels.
+const ROUNDING_SEED: u32 = 0x7e4a_1d35;
+
 fn temporal_constants() -> String {
-    use crate::shader::WgslConst::F32;
+    use crate::shader::WgslConst::{F32, U32};
     crate::shader::wgsl_consts([
         ("TEMPORAL_RAY_SIGMA_PX", F32(RAY_SIGMA_PX)),
         ("TEMPORAL_CLIP_MOTION_PX", F32(CLIP_MOTION_PX)),
         ("TEMPORAL_MOVING_RAY_SIGMA_PX", F32(MOVING_RAY_SIGMA_PX)),
+        ("TEMPORAL_ROUNDING_SEED", U32(ROUNDING_SEED)),
     ])
 }
 
