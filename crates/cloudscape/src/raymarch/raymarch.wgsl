@@ -216,9 +216,16 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
 // Offset of the samples along the ray of output texel `px`, in strata: spatiotemporal blue noise
 // (frame_blue_noise), so that each 3x3 neighbourhood spans the stratum (the seed's Bayer offsets
 // serve AABB clipping of undersampled rays the same way) and each texel's offsets spread over
-// the stratum from frame to frame. The light samples take the same offset.
+// the stratum from frame to frame. The light samples take the same offset. On a grid of divisor x
+// divisor blocks a full-resolution pixel has a ray of its own once a round of divisor^2 frames, and
+// its history is a mean of its last few: the R1 step advances once a round (the sub-pixels of a
+// round take successive steps), so that a pixel's own offsets are successive terms of R1, spread
+// over the stratum. Every 16th term of R1 (4x4) steps by 16 / phi, 0.11 short of a whole: a
+// pixel's last few offsets were nearly alike, and their error did not average.
 fn march_ray_offset(px: vec2<u32>) -> f32 {
-    return frame_blue_noise(px, frame.frame_index);
+    let round_frames = frame.grid_divisor * frame.grid_divisor;
+    let own = frame_blue_noise(px, frame.frame_index / round_frames);
+    return fract(own + f32(frame.frame_index % round_frames) * FRAME_OFFSET_STEP);
 }
 
 // One sample of one ray per texel of the output grid (1/divisor of the frame's resolution), through
