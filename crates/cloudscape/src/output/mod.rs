@@ -8,6 +8,11 @@
 //!   0 where there is no cloud), in [`CLOUD_DISTANCE_FORMAT`]; aerial perspective is applied there.
 //!
 //! The radiance is not hazed: haze is the compositor's, applied once at the cloud distance.
+//!
+//! After temporal reuse ([`crate::temporal`]) a texel may lie a little outside those ranges
+//! (radiance below 0, transmittance outside [0, 1]) at sharp edges: the history keeps the ringing
+//! of its bicubic resampling, which averages out over frames where a clamp every frame would
+//! bias it. Clamp what you show, as the compositor does.
 
 use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{STORAGE_OUTPUT, texture_2d};

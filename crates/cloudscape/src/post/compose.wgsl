@@ -57,7 +57,10 @@ fn compose_clouds_over_background(@builtin(global_invocation_id) id: vec3<u32>) 
     if id.x >= u32(frame.viewport_px.x) || id.y >= u32(frame.viewport_px.y) {
         return;
     }
-    let clouds = textureLoad(compose_clouds, vec2<i32>(id.xy), 0);
+    // A temporal history keeps its resampling's ringing (temporal_history_bicubic): clamped here,
+    // where nothing feeds back.
+    let stored = textureLoad(compose_clouds, vec2<i32>(id.xy), 0);
+    let clouds = vec4<f32>(max(stored.rgb, vec3<f32>(0.0)), clamp(stored.a, 0.0, 1.0));
     let distance_m = textureLoad(compose_cloud_distance, vec2<i32>(id.xy), 0).x;
     let uv = (vec2<f32>(id.xy) + 0.5) / frame.viewport_px;
     let hazed = environment_aerial_perspective(clouds.rgb, 1.0 - clouds.a, uv, distance_m);

@@ -41,6 +41,11 @@ fn temporal_clip(q: vec4<f32>, lo: vec4<f32>, hi: vec4<f32>) -> vec4<f32> {
 // The history at uv through a Catmull-Rom bicubic filter, nine bilinear taps (Jimenez 2016,
 // "Filmic SMAA", SIGGRAPH course; weights of Catmull & Rom 1974). A moving camera resamples the
 // history every frame: bilinear resampling blurs it a little more each time, the bicubic does not.
+// Not clamped at zero: the filter keeps an image's mean, its ringing at an edge averages out over
+// frames, and a clamp would not: a cloud base's transmittance (near 0) took only the upward half
+// of its ringing every frame while the camera climbed toward it, and the base's lower edge
+// brightened (LDR luma +0.0065 over the rows of the edge at frame 237 of the fly-through, +0.0021
+// unclamped; the full march's -0.0020). The compositor clamps what it shows.
 fn temporal_history_bicubic(uv: vec2<f32>) -> vec4<f32> {
     let size = vec2<f32>(textureDimensions(history_in));
     let pos = uv * size - 0.5;
@@ -62,7 +67,7 @@ fn temporal_history_bicubic(uv: vec2<f32>) -> vec4<f32> {
         sum += textureSampleLevel(history_in, history_linear, vec2<f32>(t12.x, y), 0.0) * (w12.x * wy);
         sum += textureSampleLevel(history_in, history_linear, vec2<f32>(t3.x, y), 0.0) * (w3.x * wy);
     }
-    return max(sum, vec4<f32>(0.0));
+    return sum;
 }
 
 // A cloud distance as the disocclusion test compares it: the far distance where there is none (0).
