@@ -343,11 +343,11 @@ pub const MOVING_RAY_SIGMA_PX: f32 = 1.2;
 /// miss, stay (clipping would keep them only at this frame's rays: the grid's pattern).
 pub const CLIP_MOTION_PX: f32 = 2.0;
 
-/// The resolve's constants as WGSL.
 /// Seed of the white noise by which the history is rounded to half floats at random
 /// (`frame_round_to_half`), apart from every other hash of the pixels.
 const ROUNDING_SEED: u32 = 0x7e4a_1d35;
 
+/// The resolve's constants as WGSL.
 fn temporal_constants() -> String {
     use crate::shader::WgslConst::{F32, U32};
     crate::shader::wgsl_consts([

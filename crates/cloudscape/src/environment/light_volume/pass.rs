@@ -203,9 +203,7 @@ impl LightVolumePass {
         );
         self.solved = Some(grid.clone());
     }
-}
 
-impl LightVolumePass {
     /// What this frame solves for `grid`, and how many cells the grid moved since the last
     /// solution when the solve starts from it (None: cold; 0: a warm frame, which takes the next
     /// cascade's turn).
