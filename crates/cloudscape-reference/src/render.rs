@@ -97,7 +97,7 @@ impl<'a, M: Medium> ProgressiveRender<'a, M> {
     /// `row_done` is told how many samples each finished row added. Returns whether the pass
     /// completed.
     ///
-    /// Sample `s` of a pixel crosses it at the R2 point `s` ([`Frame::footprint_point`]) shifted
+    /// Sample `s` of a pixel crosses it at the R2 point `s` ([`Frame::r2_point`]) shifted
     /// by a random offset per pixel and seed (a Cranley-Patterson rotation, 1976): each sample is
     /// uniform over the pixel, so the estimate stays unbiased, while together they cover it
     /// evenly (a sun disc smaller than a pixel no longer flickers from seed to seed).
@@ -122,7 +122,7 @@ impl<'a, M: Medium> ProgressiveRender<'a, M> {
                     let rotation = Rng::for_sample(seed, index, PIXEL_ROTATION_STREAM).next_vec2();
                     for s in first..first + spp {
                         let mut rng = Rng::for_sample(seed, index, u64::from(s));
-                        let within = (Frame::footprint_point(s, u32::MAX) + rotation).fract();
+                        let within = (Frame::r2_point(s) + rotation).fract();
                         let point = Vec2::new(x as f32, y as f32) + within;
                         pixel.add(tracer.camera_sample(point, &mut rng));
                     }

@@ -598,7 +598,7 @@ fn the_cloud_shadow_map_matches_the_cpu() {
 }
 
 #[test]
-fn half_float_rounding_matches_the_cpu() {
+fn frame_rounding_and_footprint_points_match_the_cpu() {
     let ctx = GpuContext::for_tests();
     let scene = Scene::default();
     let clouds = renderer(&ctx, &scene, &Frame::from_scene(&scene, SIZE));
@@ -616,6 +616,20 @@ fn half_float_rounding_matches_the_cpu() {
         let held = g.to_array().map(|v| half::f16::from_f32(v).to_f32());
         assert_eq!(g.to_array(), held, "{g} is not a half float");
     }
+    let counts = (1..=16u32).flat_map(|samples| (0..samples).map(move |i| (i, samples)));
+    let inputs: Vec<ProbeInput> = counts
+        .map(|(i, samples)| input(Vec4::new(i as f32, samples as f32, 0.0, 0.0), Vec4::ZERO))
+        .collect();
+    let got = gpu(&ctx, &clouds, ProbeFunction::FootprintPoint, &inputs);
+    let want: Vec<Vec4> = inputs
+        .iter()
+        .map(|i| {
+            Frame::footprint_point(i.a.x as u32, i.a.y as u32)
+                .extend(0.0)
+                .extend(0.0)
+        })
+        .collect();
+    assert_close("footprint points", &got, &want, 1e-5);
 }
 
 /// A CPU tone-mapping function.

@@ -23,14 +23,17 @@ struct Frame {
 @group(1) @binding(0) var<uniform> frame: Frame;
 
 // Where sample `index` of `samples` crosses its pixel, in pixel units from its corner: the centre
-// for one sample, else the R2 sequence (Roberts 2018, "The unreasonable effectiveness of
-// quasirandom sequences"). Frame::footprint_point is the same.
+// for one sample, else R2 points (Roberts 2018, "The unreasonable effectiveness of quasirandom
+// sequences") each beside its reflection through the centre, so their centroid is the centre.
+// Frame::footprint_point is the same.
 fn frame_footprint_point(index: u32, samples: u32) -> vec2<f32> {
     if samples <= 1u {
         return vec2<f32>(0.5);
     }
+    let slot = index + 2u - samples % 2u;
     let step = vec2<f32>(FRAME_FOOTPRINT_STEP_X, FRAME_FOOTPRINT_STEP_Y);
-    return fract(vec2<f32>(0.5) + f32(index) * step);
+    let point = fract(vec2<f32>(0.5) + f32(slot / 2u) * step);
+    return select(point, vec2<f32>(1.0) - point, slot % 2u == 1u);
 }
 
 // Normalised device xy of pixel coordinates `pixel` (y down).

@@ -86,6 +86,8 @@ pub enum ProbeFunction {
     PhaseBroadShare = 30,
     /// `frame_round_to_half(a, u b.x)`: `frame::round_to_half`.
     RoundToHalf = 31,
+    /// `frame_footprint_point(index a.x, samples a.y)`: `Frame::footprint_point`.
+    FootprintPoint = 32,
 }
 
 /// The inputs of one evaluation.

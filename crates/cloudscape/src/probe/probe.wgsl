@@ -56,6 +56,7 @@ fn probe_eval(f: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>) ->
         case 29u: { return vec4<f32>(environment_light_volume_ground_irradiance(a.xyz), 0.0); }
         case 30u: { return vec4<f32>(phase_broad_share(a, b.z, b.x)); }
         case 31u: { return frame_round_to_half(a, b.x); }
+        case 32u: { return vec4<f32>(frame_footprint_point(u32(a.x), u32(a.y)), 0.0, 0.0); }
         default: { return vec4<f32>(-1.0); }
     }
 }
