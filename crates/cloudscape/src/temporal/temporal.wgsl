@@ -117,10 +117,14 @@ fn temporal_ray_distance2(px: vec2<u32>) -> f32 {
 // unmarched weight far from every ray. Every pixel meets every offset from the rays once per
 // divisor^2 frames, so all pixels take in new samples at one rate and no grid shows; a ray's
 // sample spreads over the pixels around it as a soft bump, not a dot (Yang et al. 2009,
-// "Amortized supersampling": weights by the distance to the new sample).
+// "Amortized supersampling": weights by the distance to the new sample). Where the camera's step
+// moves the history, the bump widens and its peak rises toward 1 (TEMPORAL_MOVING_FRESH_SHARE):
+// the view changes under a moving camera from frame to frame, and a history that lags it shows
+// as a haze over the clouds the camera flies toward.
 fn temporal_new_weight(px: vec2<u32>, moving: f32) -> f32 {
     let sigma = mix(TEMPORAL_RAY_SIGMA_PX, TEMPORAL_MOVING_RAY_SIGMA_PX, moving);
-    return temporal.fresh_weight * exp(-temporal_ray_distance2(px) / (2.0 * sigma * sigma));
+    let fresh = mix(temporal.fresh_weight, 1.0, TEMPORAL_MOVING_FRESH_SHARE * moving);
+    return fresh * exp(-temporal_ray_distance2(px) / (2.0 * sigma * sigma));
 }
 
 @compute @workgroup_size(8, 8)
