@@ -338,12 +338,13 @@ pub const RAY_SIGMA_PX: f32 = 0.4;
 pub const MOVING_RAY_SIGMA_PX: f32 = 2.0;
 
 /// How far toward 1 the weight of a fresh sample at its ray's own pixel rises where the history
-/// moves by [`CLIP_MOTION_PX`] or more: a moving camera changes the view from frame to frame, and
-/// a history that lags it leaves a haze (climbing toward a cloud base, the 4x4 march was 0.0025
-/// brighter in LDR luma than the converged frame over the base). Fly-through FLIP of the 4x4
-/// march over the first 240 frames: 0.0302 at 0, 0.0297 at 0.5, 0.0296 at 1 (flicker 0.41x and
-/// 0.44x the full march's).
-pub const MOVING_FRESH_SHARE: f32 = 0.5;
+/// moves by [`CLIP_MOTION_PX`] or more (1: all the way, the ray's sample replaces the history at
+/// its pixel): a moving camera changes the view from frame to frame, and a history that lags it
+/// leaves a haze (climbing toward a cloud base, the 4x4 march was 0.0025 brighter in LDR luma
+/// than the converged frame over the base). Fly-through FLIP over the first 240 frames, 4x4:
+/// 0.0302 at 0, 0.0297 at 0.5, 0.0296 at 1; 2x2: 0.0198 at 0.5, 0.0190 at 1 (flicker 0.36x and
+/// 0.41x the full march's).
+pub const MOVING_FRESH_SHARE: f32 = 1.0;
 
 /// How far (pixels) the camera's step must have moved the history by parallax (against the far
 /// background) since the previous frame for it to be clipped to the current neighbourhood in
