@@ -1,8 +1,9 @@
 //! Every WGSL function with a CPU twin agrees with it on the GPU: the coarse field the light paths
 //! use (and the sprites read in one batch), camera rays and depth in every convention, aerial
 //! perspective, the sun disc, the sky, the ground, the diffuse transmittance, phase functions,
-//! height profiles, tone mapping and the half-float rounding of the temporal history. Also: a live
-//! edit of the field reaches the GPU without regenerating the noise.
+//! height profiles, tone mapping, the half-float rounding of the temporal history and the points
+//! where a pixel's samples cross it. Also: a live edit of the field reaches the GPU without
+//! regenerating the noise.
 
 use cloudscape::environment::{Environment, ViewedEnvironment};
 use cloudscape::field::read_gpu::FieldReadPass;

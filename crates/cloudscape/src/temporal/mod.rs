@@ -334,17 +334,13 @@ pub const RAY_SIGMA_PX: f32 = 0.4;
 /// The bump's width where the camera's step has moved the history [`CLIP_MOTION_PX`] or more by
 /// parallax since the previous frame: such a history is clipped, and the estimate between rays is
 /// the better guess over more of the pixels around each ray. Fly-through FLIP of the 4x4 march
-/// over the first 240 frames: 0.0378 at 0.4 px, 0.0308 at 1.2 px, 0.0302 at 2 px.
+/// over the first 240 frames: 0.0378 at 0.4 px, 0.0308 at 1.2 px, 0.0302 at 2 px. Where the
+/// history moves, the bump's peak rises from the fresh weight to 1 as well (`temporal_new_weight`):
+/// the view changes under a moving camera, and a history that lags it leaves a haze (climbing
+/// toward a cloud base, the 4x4 march was 0.0025 brighter in LDR luma than the converged frame over
+/// the base). FLIP over the same frames with the peak raised halfway, and all the way: 4x4 0.0297,
+/// 0.0296; 2x2 0.0198, 0.0190 (flicker 0.36x, 0.41x the full march's).
 pub const MOVING_RAY_SIGMA_PX: f32 = 2.0;
-
-/// How far toward 1 the weight of a fresh sample at its ray's own pixel rises where the history
-/// moves by [`CLIP_MOTION_PX`] or more (1: all the way, the ray's sample replaces the history at
-/// its pixel): a moving camera changes the view from frame to frame, and a history that lags it
-/// leaves a haze (climbing toward a cloud base, the 4x4 march was 0.0025 brighter in LDR luma
-/// than the converged frame over the base). Fly-through FLIP over the first 240 frames, 4x4:
-/// 0.0302 at 0, 0.0297 at 0.5, 0.0296 at 1; 2x2: 0.0198 at 0.5, 0.0190 at 1 (flicker 0.36x and
-/// 0.41x the full march's).
-pub const MOVING_FRESH_SHARE: f32 = 1.0;
 
 /// How far (pixels) the camera's step must have moved the history by parallax (against the far
 /// background) since the previous frame for it to be clipped to the current neighbourhood in
@@ -364,7 +360,6 @@ fn temporal_constants() -> String {
         ("TEMPORAL_RAY_SIGMA_PX", F32(RAY_SIGMA_PX)),
         ("TEMPORAL_CLIP_MOTION_PX", F32(CLIP_MOTION_PX)),
         ("TEMPORAL_MOVING_RAY_SIGMA_PX", F32(MOVING_RAY_SIGMA_PX)),
-        ("TEMPORAL_MOVING_FRESH_SHARE", F32(MOVING_FRESH_SHARE)),
         ("TEMPORAL_ROUNDING_SEED", U32(ROUNDING_SEED)),
     ])
 }

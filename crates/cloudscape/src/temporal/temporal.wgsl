@@ -118,12 +118,12 @@ fn temporal_ray_distance2(px: vec2<u32>) -> f32 {
 // divisor^2 frames, so all pixels take in new samples at one rate and no grid shows; a ray's
 // sample spreads over the pixels around it as a soft bump, not a dot (Yang et al. 2009,
 // "Amortized supersampling": weights by the distance to the new sample). Where the camera's step
-// moves the history, the bump widens and its peak rises to 1 (TEMPORAL_MOVING_FRESH_SHARE):
+// moves the history, the bump widens and its peak rises to 1 (a ray replaces the history there):
 // the view changes under a moving camera from frame to frame, and a history that lags it shows
 // as a haze over the clouds the camera flies toward.
 fn temporal_new_weight(px: vec2<u32>, moving: f32) -> f32 {
     let sigma = mix(TEMPORAL_RAY_SIGMA_PX, TEMPORAL_MOVING_RAY_SIGMA_PX, moving);
-    let fresh = mix(temporal.fresh_weight, 1.0, TEMPORAL_MOVING_FRESH_SHARE * moving);
+    let fresh = mix(temporal.fresh_weight, 1.0, moving);
     return fresh * exp(-temporal_ray_distance2(px) / (2.0 * sigma * sigma));
 }
 
