@@ -61,8 +61,6 @@ struct Varying {
     @location(8) position_m: vec3<f32>,         // world position (the view ray's direction, per fragment)
     @location(10) disc: vec2<f32>,              // on the puff's disc, in radii (its sphere's chords)
     @location(11) sun_local: vec3<f32>,         // the sun in the quad's frame: right, up, toward the eye
-    @location(12) normal: vec3<f32>,            // the quad's, toward the eye
-    @location(13) radius_m: f32,                // the puff's sphere
     @location(3) opacity: f32,                  // fades and the level's opacity
     @location(6) optical_depth: f32,            // the sprite's, through its densest column
     @location(4) distance_m: f32,
@@ -94,14 +92,6 @@ fn sprite_max_colours(p: vec3<f32>) -> array<vec3<f32>, 2> {
         select(ambient, settings.ambient_override, settings.ambient_overridden == 1u),
         select(directional, settings.directional_override, settings.directional_overridden == 1u),
     );
-}
-
-// The mean depth of first scattering along a chord of optical depth `tau` through uniform matter,
-// as a share of the chord: the mean of t over [0, tau] weighted by exp(-t), over tau,
-// 1 / tau - e^-tau / (1 - e^-tau) (1/2 for thin matter, 1 / tau for thick).
-fn sprite_scattering_depth(tau: f32) -> f32 {
-    let e = exp(-tau);
-    return select(1.0 / tau - e / (1.0 - e), 0.5, tau < 1e-3);
 }
 
 @vertex
@@ -169,8 +159,6 @@ fn vs_sprite(@builtin(vertex_index) v: u32, @builtin(instance_index) i: u32) -> 
     out.tau_sun = tau_sun;
     out.position_m = p;
     out.disc = turned;
-    out.normal = normal;
-    out.radius_m = radius;
     let sun = environment_sun_direction();
     out.sun_local = vec3<f32>(dot(sun, right), dot(sun, up), dot(sun, normal));
     out.opacity = level.a * through * edge_on * far;
@@ -243,14 +231,15 @@ fn fs_sprite(in: Varying) -> SpriteTargets {
     let cos_sun = dot(view_dir, environment_sun_direction());
     let beam = sprite_beam(tau, in.disc, normalize(in.sun_local), cos_sun, in.tau_sun) * alpha;
     let silver = thin * phase_eval(settings.phase_lobes, cos_sun);
-    // The light volume's diffuse light where the eye's light is scattered along this fragment's
-    // chord through the puff's sphere: at its mean depth of first scattering from the sphere's
-    // surface on the eye's side (read at one point per vertex, halfway to the sprite's centre,
-    // the sprites missed the glow of the surface the eye sees: inside the layer 0.504 -> 0.461).
-    let half = sprite_half_chord(in.disc);
-    let scattered_r = 2.0 * half * sprite_scattering_depth(tau);
-    let seen = in.position_m + in.normal * in.radius_m * (half - scattered_r);
-    let fragment_diffuse = settings.albedo * environment_light_volume_diffuse(seen, -view_dir);
+    // The light volume's diffuse light at the fragment's point on the sprite's plane, a smooth
+    // function of where it lies in the cloud, as the ray marcher reads it at its samples. Read at
+    // the depth of first scattering along the chord through the puff's own sphere, it was
+    // brightest at every puff's rim and darkest at its centre, whose point lay a radius out toward
+    // the eye, outside the cloud, where the P1 field's flux runs into the cloud and its radiance
+    // toward the eye falls: a deck of overlapping discs with rims ("bubble wrap"); read here,
+    // cloud-region HDR-FLIP mean over the eight scenes 0.371 -> 0.369, inside the layer 0.461 ->
+    // 0.441 (docs/sprites.md).
+    let fragment_diffuse = settings.albedo * environment_light_volume_diffuse(in.position_m, -view_dir);
     let diffuse = select(in.diffuse, fragment_diffuse, in.thin_only < 0.5);
     let radiance = alpha * diffuse + mix(beam, silver, in.thin_only) * in.single;
     return sprite_targets(radiance, alpha, in.distance_m);
