@@ -52,7 +52,7 @@ const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
 // the scene's model of multiple scattering, with tau_sun the optical depth toward the sun. With the
 // light volume (`reads_volume`, constant per entry point) only single scattering and the forward
 // peak's beam: the volume holds the rest.
-fn march_sun_scattering(p: vec3<f32>, d: vec3<f32>, tau_sun: f32, jitter: f32, reads_volume: bool) -> f32 {
+fn march_sun_scattering(p: vec3<f32>, d: vec3<f32>, tau_sun: f32, light_offset: f32, reads_volume: bool) -> f32 {
     let cos_theta = dot(d, environment_sun_direction());
     let slab = SlabModel(march.phase_lobes, march.slab_params);
     if reads_volume {
@@ -60,7 +60,7 @@ fn march_sun_scattering(p: vec3<f32>, d: vec3<f32>, tau_sun: f32, jitter: f32, r
     }
     // Both models, chosen by select: lavapipe recompiles (and leaks) a shader that branches on a
     // uniform alone at every upload. Only the slab marches back samples (back_steps = 0 else).
-    let by_slab = slab_scattering(slab, cos_theta, tau_sun, march_back_optical_depth(p, march.back_steps, jitter));
+    let by_slab = slab_scattering(slab, cos_theta, tau_sun, march_back_optical_depth(p, march.back_steps, light_offset));
     let factors = vec3<f32>(march.octave_attenuation, march.octave_contribution, march.octave_eccentricity);
     let by_octaves = phase_octaves(march.phase_lobes, factors, march.octaves, cos_theta, tau_sun);
     return select(by_octaves, by_slab, march.lighting_model == 0u);
@@ -152,8 +152,9 @@ fn march_first_stratum(t0: f32, t1: f32, n: u32, empty_until: f32) -> u32 {
     return u32(max(f32(n) * u - 1.0, 0.0));
 }
 
-// Integrates [t0, t1] in `march_step_count` strata, one sample per stratum at fraction `jitter` of it,
-// with Hillaire 2016's energy-conserving step: S_int = (S - S exp(-sigma_t dt)) / sigma_t;
+// Integrates [t0, t1] in `march_step_count` strata, one sample per stratum at fraction `jitter.x`
+// of it, its light paths at `jitter.y` of their segments (march_light_offset), with Hillaire 2016's
+// energy-conserving step: S_int = (S - S exp(-sigma_t dt)) / sigma_t;
 // L += T S_int; T *= exp(-sigma_t dt).
 // The view ray's own forward scattering (δ-M, Wiscombe 1977, on the way to the eye): the droplets'
 // diffraction peak, a share w_p of their scattering (march.view_peak_weight), deflects light by
@@ -165,7 +166,7 @@ fn march_first_stratum(t0: f32, t1: f32, n: u32, empty_until: f32) -> u32 {
 // extinction T. T, the pixel's transmittance, dims the background. w_p = 0 gives the plain march.
 // Samples in the leading empty stretch (march_empty_until) are skipped: they would read zero.
 // `volume` is the stretch inside voxel-grid boxes.
-fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volume: vec2<f32>, reads_volume: bool) -> MarchResult {
+fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: vec2<f32>, volume: vec2<f32>, reads_volume: bool) -> MarchResult {
     let n = march_step_count(t1 - t0);
     let albedo = march.albedo;
     let peak = march.view_peak_weight;
@@ -183,7 +184,7 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
     for (var i = first; i < n; i++) {
         let t_end = march_stratum_t(t0, t1, f32(i + 1u) / f32(n));
         let dt = t_end - t_start;
-        let t = t_start + jitter * dt;
+        let t = t_start + jitter.x * dt;
         let p = o + d * t;
         t_start = t_end;
         if t < empty_until {
@@ -194,8 +195,8 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
         if sigma_t <= 0.0 {
             continue;
         }
-        let tau_sun = march_sun_optical_depth(p, march.light_steps, jitter);
-        let sun = albedo * march_sun_scattering(p, d, tau_sun, jitter, reads_volume) * light.sun;
+        let tau_sun = march_sun_optical_depth(p, march.light_steps, jitter.y);
+        let sun = albedo * march_sun_scattering(p, d, tau_sun, jitter.y, reads_volume) * light.sun;
         let diffuse = albedo * (1.0 - peak) * march_diffuse(p, d, light, reads_volume);
         let step_transmittance = exp(-sigma_t * dt);
         let scaled_step = exp(-sigma_t * thinning * dt);
@@ -215,17 +216,33 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: f32, volu
 
 // Offset of the samples along the ray of output texel `px`, in strata: spatiotemporal blue noise
 // (frame_blue_noise), so that each 3x3 neighbourhood spans the stratum (the seed's Bayer offsets
-// serve AABB clipping of undersampled rays the same way) and each texel's offsets spread over
-// the stratum from frame to frame. The light samples take the same offset. On a grid of divisor x
-// divisor blocks a full-resolution pixel has a ray of its own once a round of divisor^2 frames, and
-// its history is a mean of its last few: the R1 step advances once a round (the sub-pixels of a
-// round take successive steps), so that a pixel's own offsets are successive terms of R1, spread
-// over the stratum. Every 16th term of R1 (4x4) steps by 16 / phi, 0.11 short of a whole: a
-// pixel's last few offsets were nearly alike, and their error did not average.
+// serve AABB clipping of undersampled rays the same way) and each texel's offsets spread over the
+// stratum from frame to frame (the light paths' offsets are march_light_offset's). On a grid of
+// divisor x divisor blocks a full-resolution pixel has a ray of its own once a round of divisor^2
+// frames, and its history is a mean of its last few: the R1 step advances once a round (the
+// sub-pixels of a round take successive steps), so that a pixel's own offsets are successive terms
+// of R1, spread over the stratum. Every 16th term of R1 (4x4) steps by 16 / phi, 0.11 short of a
+// whole: a pixel's last few offsets were nearly alike, and their error did not average.
 fn march_ray_offset(px: vec2<u32>) -> f32 {
     let round_frames = frame.grid_divisor * frame.grid_divisor;
     let own = frame_blue_noise(px, frame.frame_index / round_frames);
     return fract(own + f32(frame.frame_index % round_frames) * FRAME_OFFSET_STEP);
+}
+
+// Where in each of its segments a light path (toward the sun, and the slab's away from it) samples
+// the mean density, for the pixel's sample `sample_index` of `spp` whose ray is at `ray_offset`.
+// The path's segments double in length (Schneider 2015), so its last is half of a way that reaches
+// kilometres toward a low sun, and one sample there either meets a cloud on the way or misses it.
+// At the ray offsets' R2 dither that variance printed a regular lattice over every lit cloud of a
+// still (the backlit sunset, the default scene's big cumulus at 640x360; neither 4x the primary
+// steps nor 4x the light steps softened it). With several samples per pixel, each takes the middle
+// of its own stratum, the same for every pixel: the pixel's mean is stratified, and no pixel differs
+// from its neighbour by where its light samples fell. With one, the dither stays: its error averages
+// over the pixels and, through the temporal history, over frames; one offset for all (the middle)
+// was smooth but biased (the fly-through's full march against its converged frames, FLIP 0.0155 ->
+// 0.0355; the isolated cumulus against the sun's luminance 1.20 -> 1.31; docs/lighting.md).
+fn march_light_offset(ray_offset: f32, sample_index: u32, spp: u32) -> f32 {
+    return select(ray_offset, (f32(sample_index) + 0.5) / f32(spp), spp > 1u);
 }
 
 // One sample of one ray per texel of the output grid (1/divisor of the frame's resolution), through
@@ -268,7 +285,7 @@ fn march_texel(id: vec3<u32>, reads_volume: bool) {
     if t0 < t1 {
         // Samples of one pixel are stratified: offsets s / spp from the pixel's ray offset.
         let jitter = fract(march_ray_offset(px) + f32(sample_index) / f32(spp));
-        let m = march_segment(o, d, t0, t1, jitter, volume, reads_volume);
+        let m = march_segment(o, d, t0, t1, vec2<f32>(jitter, march_light_offset(jitter, sample_index, spp)), volume, reads_volume);
         result = vec4<f32>(m.radiance, m.transmittance);
         distance_m = m.distance_m;
         atomicAdd(&march_stats[0], m.density_samples);
