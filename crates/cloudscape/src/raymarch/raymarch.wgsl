@@ -152,8 +152,8 @@ fn march_first_stratum(t0: f32, t1: f32, n: u32, empty_until: f32) -> u32 {
     return u32(max(f32(n) * u - 1.0, 0.0));
 }
 
-// Integrates [t0, t1] in `march_step_count` strata, one sample per stratum at fraction `jitter.x`
-// of it, its light paths at `jitter.y` of their segments (march_light_offset), with Hillaire 2016's
+// Integrates [t0, t1] in `march_step_count` strata, one sample per stratum at fraction `offsets.x`
+// of it, its light paths at `offsets.y` of their segments (march_light_offset), with Hillaire 2016's
 // energy-conserving step: S_int = (S - S exp(-sigma_t dt)) / sigma_t;
 // L += T S_int; T *= exp(-sigma_t dt).
 // The view ray's own forward scattering (δ-M, Wiscombe 1977, on the way to the eye): the droplets'
@@ -166,7 +166,7 @@ fn march_first_stratum(t0: f32, t1: f32, n: u32, empty_until: f32) -> u32 {
 // extinction T. T, the pixel's transmittance, dims the background. w_p = 0 gives the plain march.
 // Samples in the leading empty stretch (march_empty_until) are skipped: they would read zero.
 // `volume` is the stretch inside voxel-grid boxes.
-fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: vec2<f32>, volume: vec2<f32>, reads_volume: bool) -> MarchResult {
+fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, offsets: vec2<f32>, volume: vec2<f32>, reads_volume: bool) -> MarchResult {
     let n = march_step_count(t1 - t0);
     let albedo = march.albedo;
     let peak = march.view_peak_weight;
@@ -184,7 +184,7 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: vec2<f32>
     for (var i = first; i < n; i++) {
         let t_end = march_stratum_t(t0, t1, f32(i + 1u) / f32(n));
         let dt = t_end - t_start;
-        let t = t_start + jitter.x * dt;
+        let t = t_start + offsets.x * dt;
         let p = o + d * t;
         t_start = t_end;
         if t < empty_until {
@@ -195,8 +195,8 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, jitter: vec2<f32>
         if sigma_t <= 0.0 {
             continue;
         }
-        let tau_sun = march_sun_optical_depth(p, march.light_steps, jitter.y);
-        let sun = albedo * march_sun_scattering(p, d, tau_sun, jitter.y, reads_volume) * light.sun;
+        let tau_sun = march_sun_optical_depth(p, march.light_steps, offsets.y);
+        let sun = albedo * march_sun_scattering(p, d, tau_sun, offsets.y, reads_volume) * light.sun;
         let diffuse = albedo * (1.0 - peak) * march_diffuse(p, d, light, reads_volume);
         let step_transmittance = exp(-sigma_t * dt);
         let scaled_step = exp(-sigma_t * thinning * dt);
