@@ -641,7 +641,7 @@ impl Default for Lighting {
             volume_extent_m: 8000.0,
             volume_cascades: 2,
             volume_sweeps: 32,
-            volume_warm_sweeps: 2,
+            volume_warm_sweeps: 1,
             volume_beam_steps: 24,
         }
     }

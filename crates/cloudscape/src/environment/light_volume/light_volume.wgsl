@@ -172,12 +172,12 @@ fn light_volume_limit(@builtin(global_invocation_id) id: vec3<u32>) {
     volume_diffusion[light_volume_index(c, k)] = min(light_volume_flux_limited(light_volume_transport(extinction), relative), height_m);
 }
 
-// The beam's current B along `axis` in cell i (Diffusion::beam_current).
-fn light_volume_beam_current(i: u32, axis: u32) -> vec3<f32> {
+// The beam's current in cell i per unit of the beam's direction along an axis: its current B along
+// that axis is this times -sun[axis] (Diffusion::beam_current).
+fn light_volume_beam(i: u32) -> vec3<f32> {
     let o = environment.light_volume.optics;
     let cell = volume_cells[i];
-    let beam_direction = -environment.sun_direction;
-    return 3.0 * volume_diffusion[i] * o.x * cell.w * o.y * beam_direction[axis] * cell.rgb / (4.0 * PI);
+    return 3.0 * volume_diffusion[i] * o.x * cell.w * o.y * cell.rgb / (4.0 * PI);
 }
 
 // The radiance entering the top (step 1) or bottom (-1) face of cell i as alpha I0 + beta
@@ -205,7 +205,7 @@ fn light_volume_entering(i: u32, step: i32) -> LightVolumeEntering {
 fn light_volume_face_current(i: u32, step: i32, h_y: f32) -> array<vec3<f32>, 2> {
     let conductance = 2.0 * volume_diffusion[i] / h_y;
     let entering = light_volume_entering(i, step);
-    let outward_beam = f32(step) * light_volume_beam_current(i, 1u);
+    let outward_beam = f32(step) * light_volume_beam(i) * -environment.sun_direction.y;
     let scale = 1.0 / (1.0 + 2.0 * conductance);
     return array<vec3<f32>, 2>(conductance * (1.0 - entering.alpha) * scale, (outward_beam - conductance * entering.beta) * scale);
 }
@@ -215,19 +215,31 @@ fn light_volume_harmonic(a: f32, b: f32) -> f32 {
 }
 
 // Solves column (x, z) of cascade k with its neighbours held (Diffusion::relax_column), by the
-// Thomas algorithm with a diagonal and right side per channel.
+// Thomas algorithm with a diagonal and right side per channel. Each cell's beam current and
+// diffusion coefficient are read once and carried to the next cell up, where they are the one
+// below's.
 fn light_volume_relax_column(x: u32, z: u32, k: u32, coupled: bool) {
     let v = environment.light_volume;
     let n = v.cells;
     let h = v.cascade_cell_m[k].xyz;
+    let beam_direction = -environment.sun_direction;
     var c_prime: array<vec3<f32>, LIGHT_VOLUME_MAX_COLUMN_CELLS>;
     var d_prime: array<vec3<f32>, LIGHT_VOLUME_MAX_COLUMN_CELLS>;
     var previous_c = vec3<f32>(0.0);
     var previous_d = vec3<f32>(0.0);
+    // The beams and diffusion coefficients of the cells below (0), here (1) and above (2).
+    let first = light_volume_index(vec3<u32>(x, 0u, z), k);
+    var beams = array<vec3<f32>, 3>(vec3<f32>(0.0), light_volume_beam(first), vec3<f32>(0.0));
+    var diffusions = array<f32, 3>(0.0, volume_diffusion[first], 0.0);
     for (var y = 0u; y < n.y; y++) {
         let c = vec3<u32>(x, y, z);
         let i = light_volume_index(c, k);
-        let d = volume_diffusion[i];
+        if y + 1u < n.y {
+            let above = light_volume_index(vec3<u32>(x, y + 1u, z), k);
+            beams[2] = light_volume_beam(above);
+            diffusions[2] = volume_diffusion[above];
+        }
+        let d = diffusions[1];
         let cell = volume_cells[i];
         var diag = vec3<f32>(cell.w * (1.0 - v.optics.x));
         var rhs = v.optics.x * cell.w * cell.rgb / (4.0 * PI);
@@ -244,7 +256,7 @@ fn light_volume_relax_column(x: u32, z: u32, k: u32, coupled: bool) {
                 var nc = c;
                 nc[axis] = u32(neighbour);
                 let j = light_volume_index(nc, k);
-                let face_b = 0.5 * (light_volume_beam_current(i, axis) + light_volume_beam_current(j, axis));
+                let face_b = 0.5 * (beams[1] + light_volume_beam(j)) * beam_direction[axis];
                 rhs -= f32(step) * face_b / h[axis];
                 if coupled {
                     let conductance = light_volume_harmonic(d, volume_diffusion[j]) / (h[axis] * h[axis]);
@@ -256,17 +268,15 @@ fn light_volume_relax_column(x: u32, z: u32, k: u32, coupled: bool) {
         for (var s = 0; s < 2; s++) {
             let step = s * 2 - 1;
             let neighbour = i32(y) + step;
-            let b_here = light_volume_beam_current(i, 1u);
             if neighbour < 0 || neighbour >= i32(n.y) {
                 let face = light_volume_face_current(i, step, h.y);
                 diag += face[0] / h.y;
                 rhs -= face[1] / h.y;
                 continue;
             }
-            let j = light_volume_index(vec3<u32>(x, u32(neighbour), z), k);
-            let face_b = 0.5 * (b_here + light_volume_beam_current(j, 1u));
+            let face_b = 0.5 * (beams[1] + beams[s * 2]) * beam_direction.y;
             rhs -= f32(step) * face_b / h.y;
-            let conductance = light_volume_harmonic(d, volume_diffusion[j]) / (h.y * h.y);
+            let conductance = light_volume_harmonic(d, diffusions[s * 2]) / (h.y * h.y);
             diag += vec3<f32>(conductance);
             if step < 0 {
                 lower = -conductance;
@@ -279,6 +289,8 @@ fn light_volume_relax_column(x: u32, z: u32, k: u32, coupled: bool) {
         previous_d = (rhs - lower * previous_d) / m;
         c_prime[y] = previous_c;
         d_prime[y] = previous_d;
+        beams = array<vec3<f32>, 3>(beams[1], beams[2], vec3<f32>(0.0));
+        diffusions = array<f32, 3>(diffusions[1], diffusions[2], 0.0);
     }
     var next = vec3<f32>(0.0);
     for (var r = 0u; r < n.y; r++) {
@@ -292,18 +304,21 @@ fn light_volume_relax_column(x: u32, z: u32, k: u32, coupled: bool) {
     }
 }
 
-// Relaxes the columns of one colour ((x + z) % 2 == colour) of every cascade swept.
+// Relaxes the columns of one colour ((x + z) % 2 == colour) of every cascade swept: invocation
+// (i, row) takes column x = 2 i + (colour + z) % 2 of its row, so no invocation idles on the
+// other colour's columns (a dispatch over half of x).
 fn light_volume_relax(id: vec2<u32>, colour: u32, coupled: bool) {
     let n = light_volume_cells_of();
-    if id.x >= n.x || id.y >= n.z * volume_solve.swept {
+    if id.y >= n.z * volume_solve.swept {
         return;
     }
     let z = id.y % n.z;
     let k = id.y / n.z + volume_solve.first_swept;
-    if (id.x + z) % 2u != colour {
+    let x = 2u * id.x + (colour + z) % 2u;
+    if x >= n.x {
         return;
     }
-    light_volume_relax_column(id.x, z, k, coupled);
+    light_volume_relax_column(x, z, k, coupled);
 }
 
 @compute @workgroup_size(8, 8)
@@ -367,10 +382,7 @@ fn light_volume_export(@builtin(global_invocation_id) id: vec3<u32>) {
     let k = ck.w;
     let i = light_volume_index(c, k);
     let h = v.cascade_cell_m[k].xyz;
-    var beam = vec3<f32>(0.0);
-    for (var axis = 0u; axis < 3u; axis++) {
-        beam[axis] = dot(light_volume_beam_current(i, axis), LIGHT_VOLUME_LUMINANCE);
-    }
+    let beam = dot(light_volume_beam(i), LIGHT_VOLUME_LUMINANCE) * -environment.sun_direction;
     let current = -volume_diffusion[i] * light_volume_gradient(c, k).xyz + beam;
     let radiance = volume_radiance[i].rgb;
     var relative = current / max(dot(radiance, LIGHT_VOLUME_LUMINANCE), 1e-12);

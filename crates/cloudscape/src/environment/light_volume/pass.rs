@@ -157,7 +157,7 @@ impl LightVolumePass {
         let writing = environment.bind_group_writing(EnvironmentTable::LightVolume);
         let groups = shared.bind_groups_with(pass.slots, writing, group);
         let over_swept_cells = UVec2::new(n.x, n.y * n.z * solve.swept);
-        let over_columns = UVec2::new(n.x, n.z * solve.swept);
+        let over_columns = UVec2::new(n.x.div_ceil(2), n.z * solve.swept);
         let sweeps = match moved_cells {
             None => settings.sweeps.max(1),
             Some(moved) => (settings.warm_sweeps + moved).min(settings.sweeps.max(1)),
