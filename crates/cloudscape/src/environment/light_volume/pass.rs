@@ -157,7 +157,8 @@ impl LightVolumePass {
         let writing = environment.bind_group_writing(EnvironmentTable::LightVolume);
         let groups = shared.bind_groups_with(pass.slots, writing, group);
         let over_swept_cells = UVec2::new(n.x, n.y * n.z * solve.swept);
-        let over_columns = UVec2::new(n.x.div_ceil(2), n.z * solve.swept);
+        // A sweep relaxes the columns of one colour, then the other's: half of x each.
+        let over_one_colour = UVec2::new(n.x.div_ceil(2), n.z * solve.swept);
         let sweeps = match moved_cells {
             None => settings.sweeps.max(1),
             Some(moved) => (settings.warm_sweeps + moved).min(settings.sweeps.max(1)),
@@ -167,8 +168,8 @@ impl LightVolumePass {
             let coupled = !(moved_cells.is_none() && s == 0);
             steps.push((ENTRIES[2], over_swept_cells));
             let (red, black) = if coupled { (3, 4) } else { (5, 6) };
-            steps.push((ENTRIES[red], over_columns));
-            steps.push((ENTRIES[black], over_columns));
+            steps.push((ENTRIES[red], over_one_colour));
+            steps.push((ENTRIES[black], over_one_colour));
         }
         let [cells_name, solve_name, table_name] = LIGHT_VOLUME_PASS_NAMES;
         let mut record = |label, steps: &[(&str, UVec2)]| {
