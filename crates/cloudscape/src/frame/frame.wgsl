@@ -88,19 +88,6 @@ fn frame_depth_distance(pixel: vec2<f32>, depth: f32) -> f32 {
     return length(frame_view_point(pixel, depth));
 }
 
-// A per-pixel, per-frame value in [0, 1) whose error averages away in space and in time: the R2
-// sequence over the pixels (Roberts 2018, "The unreasonable effectiveness of quasirandom
-// sequences": fract(x / g + y / g^2) for the plastic number g, a dither whose spectrum is
-// blue-noise-like, so neighbouring pixels' offsets cover the unit interval evenly and a 3x3
-// neighbourhood spans it) plus the golden-ratio R1 sequence over frames, so each pixel's offsets
-// stratify the interval in time. White noise (the PCG hash) left grain that neither the eye nor a
-// temporal history averages as fast.
-fn frame_blue_noise(pixel: vec2<u32>, index: u32) -> f32 {
-    let p = vec2<f32>(pixel % vec2<u32>(4096u));
-    let spatial = fract(p.x * FRAME_FOOTPRINT_STEP_X + p.y * FRAME_FOOTPRINT_STEP_Y);
-    return fract(spatial + f32(index % 4096u) * FRAME_OFFSET_STEP);
-}
-
 // v rounded to a value a half float holds: up or down at random, with the probabilities that keep
 // its expectation (stochastic rounding: Forsythe 1959, "Reprint of a note on rounding-off errors",
 // SIAM Review 1; Connolly, Higham & Mary 2021, "Stochastic rounding and its probabilistic backward

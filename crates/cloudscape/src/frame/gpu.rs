@@ -67,7 +67,7 @@ pub static FRAME_WGSL: crate::shader::WgslModule = crate::shader::wgsl_module!(
 );
 
 /// The frame's constants as WGSL: the step of the R2 sequence ([`super::FOOTPRINT_STEP`]) of the
-/// footprint and of the pixels' ray offsets, and the golden-ratio step of the offsets over frames
+/// footprint, and the golden-ratio step of the ray offsets over frames
 /// ([`super::FRAME_OFFSET_STEP`]).
 fn frame_constants() -> String {
     use crate::shader::WgslConst::F32;

@@ -25,7 +25,7 @@ pub const CLOUD_DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32F
 
 /// Which rays an output holds: one per pixel of a grid at 1/`divisor` of the frame's resolution,
 /// through sub-pixel `subpixel` of each block (the rays' offsets along them follow the frame index:
-/// `frame_blue_noise` in `frame.wgsl`). This is the frame's jitter; [`crate::frame::FrameGpu`]
+/// `march_ray_offset` in `raymarch.wgsl`). This is the frame's jitter; [`crate::frame::FrameGpu`]
 /// carries it to every technique.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SampleGrid {

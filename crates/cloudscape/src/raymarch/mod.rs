@@ -2,6 +2,7 @@
 //! that writes, per output texel, the radiance the clouds scatter toward the eye, the transmittance
 //! through them and the cloud distance ([`crate::output`]), stopping at the host's depth buffer.
 
+mod blue_noise;
 pub mod light;
 
 use crate::field::FieldError;
@@ -183,6 +184,8 @@ pub struct RaymarchRenderer {
     stats: wgpu::Buffer,
     stats_readback: LateReadback,
     sums: wgpu::Buffer,
+    /// The ray offsets' dither ([`blue_noise`]).
+    blue_noise: wgpu::TextureView,
     group: BindGroupCache,
     settings: MarchUniform,
 }
@@ -196,6 +199,7 @@ impl RaymarchRenderer {
             stats: storage_buffer(ctx, "raymarch stats", STATS_BYTES),
             stats_readback: LateReadback::new(ctx, "raymarch stats readback", STATS_BYTES),
             sums: storage_buffer(ctx, "raymarch sums", size_of::<MarchSum>() as u64),
+            blue_noise: blue_noise::blue_noise_texture(ctx),
             group: BindGroupCache::default(),
             settings: MarchUniform::zeroed(),
         }
@@ -278,6 +282,7 @@ impl Technique for RaymarchRenderer {
         self.ensure_sums(ctx, size.x * size.y);
         let entry = ENTRIES[usize::from(self.reads_light_volume())];
         let (march, stats, sums, pass) = (&self.march, &self.stats, &self.sums, &self.pass);
+        let blue_noise = &self.blue_noise;
         let output = targets.output;
         let group = self.group.get(
             &[targets.host_depth, &output.radiance, &output.distance],
@@ -292,6 +297,7 @@ impl Technique for RaymarchRenderer {
                         ("march_stats", stats.as_entire_binding()),
                         ("cloud_distance_out", TextureView(&output.distance)),
                         ("march_sums", sums.as_entire_binding()),
+                        ("march_blue_noise", TextureView(blue_noise)),
                     ],
                 )
             },

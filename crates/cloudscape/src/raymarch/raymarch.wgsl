@@ -45,6 +45,8 @@ struct MarchSum {
 @group(3) @binding(3) var<storage, read_write> march_stats: array<atomic<u32>, 2>;
 @group(3) @binding(4) var cloud_distance_out: texture_storage_2d<r32float, write>;
 @group(3) @binding(5) var<storage, read_write> march_sums: array<MarchSum>;
+// The ray offsets' blue-noise tile (raymarch/blue_noise.rs), repeated over the image.
+@group(3) @binding(6) var march_blue_noise: texture_2d<f32>;
 
 // Rays stop once this little light gets through (VolumeCloud's threshold, peers.md).
 const MARCH_MIN_TRANSMITTANCE: f32 = 0.005;
@@ -214,19 +216,21 @@ fn march_segment(o: vec3<f32>, d: vec3<f32>, t0: f32, t1: f32, offsets: vec2<f32
     return MarchResult(radiance, transmittance, samples, distance_m);
 }
 
-// Offset of the samples along the ray of output texel `px`, in strata: spatiotemporal blue noise
-// (frame_blue_noise), so that each 3x3 neighbourhood spans the stratum (the seed's Bayer offsets
-// serve AABB clipping of undersampled rays the same way) and each texel's offsets spread over the
-// stratum from frame to frame (the light paths' offsets are march_light_offset's). On a grid of
-// divisor x divisor blocks a full-resolution pixel has a ray of its own once a round of divisor^2
-// frames, and its history is a mean of its last few: the R1 step advances once a round (the
-// sub-pixels of a round take successive steps), so that a pixel's own offsets are successive terms
-// of R1, spread over the stratum. Every 16th term of R1 (4x4) steps by 16 / phi, 0.11 short of a
-// whole: a pixel's last few offsets were nearly alike, and their error did not average.
+// Offset of the samples along the ray of output texel `px`, in strata: the blue-noise tile
+// (raymarch/blue_noise.rs: each 3x3 neighbourhood spans the stratum, as the seed's Bayer offsets
+// serve AABB clipping of undersampled rays, without the R2 dither's lattice) plus the golden-ratio
+// R1 sequence over frames (Roberts 2018), so each texel's offsets spread over the stratum from
+// frame to frame (the light paths' offsets are march_light_offset's). On a grid of divisor x
+// divisor blocks a full-resolution pixel has a ray of its own once a round of divisor^2 frames,
+// and its history is a mean of its last few: the R1 step advances once a round (the sub-pixels of
+// a round take successive steps), so that a pixel's own offsets are successive terms of R1, spread
+// over the stratum. Every 16th term of R1 (4x4) steps by 16 / phi, 0.11 short of a whole: a
+// pixel's last few offsets were nearly alike, and their error did not average.
 fn march_ray_offset(px: vec2<u32>) -> f32 {
     let round_frames = frame.grid_divisor * frame.grid_divisor;
-    let own = frame_blue_noise(px, frame.frame_index / round_frames);
-    return fract(own + f32(frame.frame_index % round_frames) * FRAME_OFFSET_STEP);
+    let tile = textureLoad(march_blue_noise, vec2<i32>(px % textureDimensions(march_blue_noise)), 0).x;
+    let round = (frame.frame_index / round_frames) % 4096u;
+    return fract(tile + fract(f32(round) * FRAME_OFFSET_STEP) + f32(frame.frame_index % round_frames) * FRAME_OFFSET_STEP);
 }
 
 // Where in each of its segments a light path (toward the sun, and the slab's away from it) samples

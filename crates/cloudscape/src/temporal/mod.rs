@@ -196,7 +196,7 @@ impl TemporalResolve {
     }
 
     /// The rays frame `frame_index` renders: its sub-pixel of each block (Bayer order); their
-    /// offsets along the rays follow the frame index (`frame_blue_noise`, `frame.wgsl`). The frame
+    /// offsets along the rays follow the frame index (`march_ray_offset`, `raymarch.wgsl`). The frame
     /// index must advance every frame.
     pub fn grid(&self, frame_index: u32) -> SampleGrid {
         let divisor = self.settings.divisor;
