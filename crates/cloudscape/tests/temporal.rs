@@ -229,7 +229,7 @@ fn a_camera_cut_restarts_the_history() {
 
 #[test]
 fn lighting_carried_across_frames_keeps_the_image_of_a_still() {
-    use cloudscape::environment::light_volume::CELL_SLICES;
+    use cloudscape::environment::light_volume::{CELL_SLICES, WARM_TURN_FRAMES};
     use cloudscape::shadow::LightingReuse;
     let ctx = GpuContext::for_tests();
     let scene = scene();
@@ -250,8 +250,8 @@ fn lighting_carried_across_frames_keeps_the_image_of_a_still() {
         .clouds()
         .set_lighting_reuse(Some(LightingReuse::REAL_TIME));
     carried.render_frame(&ctx, &before, Reuse::None, &mut timer);
-    // Each frame solves one cascade and updates a slice of its cells: twice round them all.
-    for _ in 0..2 * CELL_SLICES * scene.lighting.volume_cascades {
+    // Each turn of frames solves one cascade and updates a slice of its cells: twice round them all.
+    for _ in 0..2 * CELL_SLICES * scene.lighting.volume_cascades * WARM_TURN_FRAMES {
         carried.render_frame(&ctx, &later, Reuse::None, &mut timer);
     }
     let error = flip_mean(&carried.images(&ctx).ldr, &reference);

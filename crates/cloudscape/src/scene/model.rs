@@ -586,8 +586,9 @@ pub struct Lighting {
     pub volume_cascades: u32,
     /// Light volume: relaxation sweeps when the grid is new or has moved, 1..256.
     pub volume_sweeps: u32,
-    /// Light volume: sweeps a frame gives the one cascade it solves while the grid stays put
-    /// (warm-started from the last frame; the cascades take turns), 0..64.
+    /// Light volume: sweeps a turn gives the one cascade it solves while the grid stays put
+    /// (warm-started from the last solution; the cascades take turns of three frames: the
+    /// cells, the sweeps, the table), 0..64.
     pub volume_warm_sweeps: u32,
     /// Light volume: samples of the coarse field toward the sun per cell, 4..64.
     pub volume_beam_steps: u32,

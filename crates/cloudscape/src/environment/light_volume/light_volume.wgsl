@@ -20,13 +20,13 @@ struct LightVolumeSolve {
     shift_cells: array<vec4<i32>, LIGHT_VOLUME_MAX_CASCADES>, // xy: where this frame's cells lay in the grid last solved, in whole cells along x and z
     first_swept: u32,                                         // the first cascade the sweeps and the table cover
     swept: u32,                                               // how many, from it
-    cell_slice: u32,                                          // the slice of the swept cells' rows a warm frame updates
-    pad0: u32,
+    cell_slice: u32,                                          // the slice of the swept cells' rows a warm turn updates
+    turn_frame: u32,                                          // which frame of a warm turn this is (the passes record only its part)
 }
 @group(3) @binding(4) var<uniform> volume_solve: LightVolumeSolve;
 
 // The cell and cascade of an invocation of a dispatch over the cells of the cascades swept this
-// frame (x, the rest): a warm frame sweeps one cascade, in turn, and its dispatches cover that
+// frame (x, the rest): a warm turn sweeps one cascade, in turn, and its dispatches cover that
 // cascade alone.
 fn light_volume_swept_cell_of(id: vec2<u32>) -> vec4<u32> {
     return light_volume_cell_of(id) + vec4<u32>(0u, 0u, 0u, volume_solve.first_swept);
@@ -75,8 +75,8 @@ fn light_volume_cells(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // The cells' inputs of one slice of the swept cascade's rows: every LIGHT_VOLUME_CELL_SLICES-th,
-// from the frame's cell_slice. A warm frame updates one slice and keeps the others' inputs from
-// the last frames (a few frames old: the clouds move 0.13 m a frame at 60 fps in an 8 m/s wind).
+// from the frame's cell_slice. A warm turn updates one slice and keeps the others' inputs from
+// the last turns (under a second old: the clouds move 0.13 m a frame at 60 fps in an 8 m/s wind).
 @compute @workgroup_size(8, 8)
 fn light_volume_cells_slice(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = light_volume_cells_of();

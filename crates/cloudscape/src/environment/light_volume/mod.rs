@@ -31,7 +31,9 @@ pub mod solve;
 #[cfg(test)]
 mod tests;
 
-pub use pass::{CELL_SLICES, LIGHT_VOLUME_PASS_NAMES, LIGHT_VOLUME_WGSL, LightVolumePass};
+pub use pass::{
+    CELL_SLICES, LIGHT_VOLUME_PASS_NAMES, LIGHT_VOLUME_WGSL, LightVolumePass, WARM_TURN_FRAMES,
+};
 pub use read::{CASCADE_BLEND_CELLS, LightVolume};
 pub use solve::{Boundaries, DiffuseField, Diffusion};
 
@@ -92,7 +94,7 @@ pub struct LightVolumeSettings {
     pub cascades: u32,
     /// Sweeps of a cold start (the grid new or moved).
     pub sweeps: u32,
-    /// Sweeps a warm frame gives the one cascade it solves (the cascades take turns).
+    /// Sweeps a warm turn gives the one cascade it solves (the cascades take turns).
     pub warm_sweeps: u32,
     /// Samples of the mean field toward the sun per cell.
     pub beam_steps: u32,

@@ -30,11 +30,18 @@ const ENTRIES: [&str; 9] = [
     "light_volume_scroll",
 ];
 
-/// Slices a cascade's rows are updated in on warm frames, one a turn: a warm frame recomputes the
-/// inputs (the mean field's extinction, the sun's beam through it) of a quarter of the cells of
-/// the cascade it solves, so that a cell's inputs are at most `CELL_SLICES` times the cascades
-/// frames old (8 in the default scene: the clouds move 1 m in that time at 60 fps).
-pub const CELL_SLICES: u32 = 4;
+/// Slices a cascade's rows are updated in on warm frames, one a turn: a turn recomputes the inputs
+/// (the mean field's extinction, the sun's beam through it) of an eighth of the cells of the
+/// cascade it solves, so that a cell's inputs are at most `CELL_SLICES` times the cascades turns
+/// old (48 frames in the default scene: 0.8 s at 60 fps, in which an 8 m/s wind moves the clouds
+/// 6 m through cells 333 m wide).
+pub const CELL_SLICES: u32 = 8;
+
+/// Frames a warm turn is spread over, one part each: the slice of the cells' inputs, the sweeps,
+/// the table. Each frame then carries a third of the volume's work, evenly, rather than all of it
+/// (a cascade still gets ten sweeps a second at 60 fps, against clouds that cross one of its cells
+/// in 40 s); the environment reads the last table until the turn writes the next.
+pub const WARM_TURN_FRAMES: u32 = 3;
 
 /// The most cells (of any cascade) a recentred grid may have moved for its solve to start from the
 /// last solution scrolled: twice [`super::RECENTRE_CELLS`] (in the default scene 2.7 km, a frame's
@@ -103,8 +110,9 @@ impl LightVolumePass {
     /// solve of `settings.sweeps` sweeps when the grid is new or the frame may not start warm;
     /// when the grid was recentred by whole cells, the last solution scrolled with it, every
     /// cell's inputs and `warm_sweeps` more sweeps than it moved cells (the solution spreads a
-    /// cell a sweep into the new columns); else, amortised over frames, `warm_sweeps` of one
-    /// cascade from the last solution, each cascade in turn, and a slice of the cells' inputs.
+    /// cell a sweep into the new columns); else, amortised over frames, one part of a warm turn
+    /// ([`WARM_TURN_FRAMES`]): a slice of one cascade's cells' inputs, its `warm_sweeps` from the
+    /// last solution, or its table, the cascades in turn.
     pub fn encode(
         &mut self,
         ctx: &GpuContext,
@@ -117,28 +125,23 @@ impl LightVolumePass {
             grid.cells.y <= MAX_COLUMN_CELLS,
             "the light volume's columns hold at most {MAX_COLUMN_CELLS} cells"
         );
-        let cascades = grid.cascades.len() as u32;
         let remade = self.ensure_buffers(ctx, grid);
         let (solve, moved_cells) = self.plan(grid, !remade && may_start_warm);
         ctx.queue
             .write_buffer(&self.solve, 0, bytemuck::bytes_of(&solve));
         let buffers = self.buffers.as_ref().expect("made above");
-        let n = grid.cells;
-        let over_cells = UVec2::new(n.x, n.y * n.z * cascades);
-        let mut first = Vec::new();
+        let parts = TurnParts::of(moved_cells, solve.turn_frame);
+        let passes = [
+            cells_steps(grid, &solve, moved_cells),
+            solve_steps(grid, &solve, moved_cells, settings),
+            table_steps(grid, &solve),
+        ];
         match moved_cells {
-            None => {
-                encoder.clear_buffer(&buffers[1], 0, None);
-                first.push((ENTRIES[0], over_cells));
-            }
-            Some(0) => first.push((
-                ENTRIES[1],
-                UVec2::new(n.x, (n.y * n.z).div_ceil(CELL_SLICES)),
-            )),
-            Some(_) => {
+            None => encoder.clear_buffer(&buffers[1], 0, None),
+            Some(1..) => {
                 encoder.copy_buffer_to_buffer(&buffers[1], 0, &buffers[3], 0, buffers[1].size());
-                first.extend([(ENTRIES[8], over_cells), (ENTRIES[0], over_cells)]);
             }
+            Some(0) => {}
         }
         let pass = &self.pass;
         let solve_buffer = &self.solve;
@@ -156,23 +159,12 @@ impl LightVolumePass {
         });
         let writing = environment.bind_group_writing(EnvironmentTable::LightVolume);
         let groups = shared.bind_groups_with(pass.slots, writing, group);
-        let over_swept_cells = UVec2::new(n.x, n.y * n.z * solve.swept);
-        // A sweep relaxes the columns of one colour, then the other's: half of x each.
-        let over_one_colour = UVec2::new(n.x.div_ceil(2), n.z * solve.swept);
-        let sweeps = match moved_cells {
-            None => settings.sweeps.max(1),
-            Some(moved) => (settings.warm_sweeps + moved).min(settings.sweeps.max(1)),
-        };
-        let mut steps = Vec::new();
-        for s in 0..sweeps {
-            let coupled = !(moved_cells.is_none() && s == 0);
-            steps.push((ENTRIES[2], over_swept_cells));
-            let (red, black) = if coupled { (3, 4) } else { (5, 6) };
-            steps.push((ENTRIES[red], over_one_colour));
-            steps.push((ENTRIES[black], over_one_colour));
-        }
-        let [cells_name, solve_name, table_name] = LIGHT_VOLUME_PASS_NAMES;
-        let mut record = |label, steps: &[(&str, UVec2)]| {
+        let parts_of_turn = [parts.cells, parts.sweeps, parts.table];
+        for ((label, steps), part) in LIGHT_VOLUME_PASS_NAMES
+            .iter()
+            .zip(passes)
+            .zip(parts_of_turn)
+        {
             let writes = timer
                 .as_deref_mut()
                 .and_then(|t| t.compute_pass_writes(label));
@@ -180,6 +172,9 @@ impl LightVolumePass {
                 label: Some(label),
                 timestamp_writes: writes,
             });
+            if !part {
+                continue;
+            }
             for (i, g) in groups.iter().enumerate() {
                 if let Some(g) = g {
                     compute.set_bind_group(i as u32, *g, &[]);
@@ -189,25 +184,17 @@ impl LightVolumePass {
                 compute.set_pipeline(pass.pipeline(entry));
                 compute.dispatch_workgroups(size.x.div_ceil(8), size.y.div_ceil(8), 1);
             }
-        };
-        record(cells_name, &first);
-        record(solve_name, &steps);
-        record(table_name, &[(ENTRIES[7], over_swept_cells)]);
-        copy_table(
-            encoder,
-            (
-                &buffers[3],
-                environment.texture(EnvironmentTable::LightVolume),
-            ),
-            grid,
-            &solve,
-        );
+        }
+        if parts.table {
+            let table = environment.texture(EnvironmentTable::LightVolume);
+            copy_table(encoder, (&buffers[3], table), grid, &solve);
+        }
         self.solved = Some(grid.clone());
     }
 
     /// What this frame solves for `grid`, and how many cells the grid moved since the last
     /// solution when the solve starts from it (None: cold; 0: a warm frame, which takes the next
-    /// cascade's turn).
+    /// part of a turn, the turns going round the cascades).
     fn plan(
         &mut self,
         grid: &LightVolumeGrid,
@@ -227,17 +214,93 @@ impl LightVolumePass {
         for (c, s) in solve.shift_cells.iter_mut().zip(scrolled) {
             *c = s.extend(0).extend(0);
         }
+        let turn = self.warm_frames / WARM_TURN_FRAMES;
+        solve.turn_frame = self.warm_frames % WARM_TURN_FRAMES;
         (solve.first_swept, solve.swept) = match moved_cells {
-            Some(0) => (self.warm_frames % cascades, 1),
+            Some(0) => (turn % cascades, 1),
             _ => (0, cascades),
         };
-        solve.cell_slice = (self.warm_frames / cascades) % CELL_SLICES;
+        solve.cell_slice = (turn / cascades) % CELL_SLICES;
         self.warm_frames = match moved_cells {
             Some(0) => self.warm_frames.wrapping_add(1),
             _ => 0,
         };
         (solve, moved_cells)
     }
+}
+
+/// Which of the volume's passes a frame records: all of them in a cold or scrolled frame, one in
+/// each frame of a warm turn.
+struct TurnParts {
+    cells: bool,
+    sweeps: bool,
+    table: bool,
+}
+
+impl TurnParts {
+    fn of(moved_cells: Option<u32>, turn_frame: u32) -> TurnParts {
+        let warm = moved_cells == Some(0);
+        TurnParts {
+            cells: !warm || turn_frame == 0,
+            sweeps: !warm || turn_frame == 1,
+            table: !warm || turn_frame == 2,
+        }
+    }
+}
+
+/// A compute step: an entry point of `light_volume.wgsl` and the size of its 2-D dispatch.
+type Step = (&'static str, UVec2);
+
+/// The cells' inputs: every cell's of a cold solve, the scroll and every cell's of a scrolled
+/// one, a slice of the swept cascade's of a warm one.
+fn cells_steps(grid: &LightVolumeGrid, solve: &SolveUniform, moved: Option<u32>) -> Vec<Step> {
+    let n = grid.cells;
+    let over_cells = UVec2::new(n.x, n.y * n.z * grid.cascades.len() as u32);
+    match moved {
+        None => vec![(ENTRIES[0], over_cells)],
+        Some(0) => {
+            let rows = (n.y * n.z * solve.swept).div_ceil(CELL_SLICES);
+            vec![(ENTRIES[1], UVec2::new(n.x, rows))]
+        }
+        Some(_) => vec![(ENTRIES[8], over_cells), (ENTRIES[0], over_cells)],
+    }
+}
+
+/// The sweeps: `settings.sweeps` of a cold solve, `warm_sweeps` and one per cell moved of a
+/// scrolled one, `warm_sweeps` of a warm one; each the flux limiter, then the red columns, then
+/// the black (the first of a cold solve without the horizontal coupling, which it has nothing to
+/// couple to yet).
+fn solve_steps(
+    grid: &LightVolumeGrid,
+    solve: &SolveUniform,
+    moved: Option<u32>,
+    settings: &LightVolumeSettings,
+) -> Vec<Step> {
+    let n = grid.cells;
+    let over_swept_cells = UVec2::new(n.x, n.y * n.z * solve.swept);
+    // A sweep relaxes the columns of one colour, then the other's: half of x each.
+    let over_one_colour = UVec2::new(n.x.div_ceil(2), n.z * solve.swept);
+    let sweeps = match moved {
+        None => settings.sweeps.max(1),
+        Some(moved) => (settings.warm_sweeps + moved).min(settings.sweeps.max(1)),
+    };
+    let mut steps = Vec::new();
+    for s in 0..sweeps {
+        let coupled = !(moved.is_none() && s == 0);
+        let (red, black) = if coupled { (3, 4) } else { (5, 6) };
+        steps.extend([
+            (ENTRIES[2], over_swept_cells),
+            (ENTRIES[red], over_one_colour),
+            (ENTRIES[black], over_one_colour),
+        ]);
+    }
+    steps
+}
+
+/// The table of the swept cascades.
+fn table_steps(grid: &LightVolumeGrid, solve: &SolveUniform) -> Vec<Step> {
+    let n = grid.cells;
+    vec![(ENTRIES[7], UVec2::new(n.x, n.y * n.z * solve.swept))]
 }
 
 /// What a frame's passes solve: `LightVolumeSolve` of `light_volume.wgsl`.
@@ -251,9 +314,10 @@ struct SolveUniform {
     first_swept: u32,
     /// How many cascades, from it.
     swept: u32,
-    /// The slice of the swept cascades' rows whose inputs a warm frame updates.
+    /// The slice of the swept cascades' rows whose inputs a warm turn updates.
     cell_slice: u32,
-    pad0: u32,
+    /// Which frame of a warm turn this is ([`WARM_TURN_FRAMES`]).
+    turn_frame: u32,
 }
 
 /// Texels of a row of the staged table for `width` cells: padded to [`ROW_TEXELS`].
@@ -348,7 +412,7 @@ mod tests {
                 first_swept,
                 swept,
                 cell_slice,
-                pad0
+                turn_frame
             }
         );
     }
