@@ -237,13 +237,13 @@ fn march_ray_offset(px: vec2<u32>) -> f32 {
 // the mean density, for the pixel's sample `sample_index` of `spp` whose ray is at `ray_offset`.
 // The path's segments double in length (Schneider 2015), so its last is half of a way that reaches
 // kilometres toward a low sun, and one sample there either meets a cloud on the way or misses it.
-// At the ray offsets' R2 dither that variance printed a regular lattice over every lit cloud of a
-// still (the backlit sunset, the default scene's big cumulus at 640x360; neither 4x the primary
+// At the ray offsets' former R2 dither that variance printed a regular lattice over every lit cloud
+// of a still (the backlit sunset, the default scene's big cumulus at 640x360; neither 4x the primary
 // steps nor 4x the light steps softened it). With several samples per pixel, each takes the middle
 // of its own stratum, the same for every pixel: the pixel's mean is stratified, and no pixel differs
-// from its neighbour by where its light samples fell. With one, the dither stays: its error averages
-// over the pixels and, through the temporal history, over frames; one offset for all (the middle)
-// was smooth but biased (the fly-through's full march against its converged frames, FLIP 0.0155 ->
+// from its neighbour by where its light samples fell. With one, the ray's blue-noise offset stays:
+// its error is grain without a lattice, which averages over the pixels and, through the temporal
+// history, over frames; one offset for all (the middle) was smooth but biased (the fly-through's full march against its converged frames, FLIP 0.0155 ->
 // 0.0355; the isolated cumulus against the sun's luminance 1.20 -> 1.31; docs/lighting.md).
 fn march_light_offset(ray_offset: f32, sample_index: u32, spp: u32) -> f32 {
     return select(ray_offset, (f32(sample_index) + 0.5) / f32(spp), spp > 1u);
