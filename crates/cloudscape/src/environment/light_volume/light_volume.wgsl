@@ -21,7 +21,7 @@ struct LightVolumeSolve {
     first_swept: u32,                                         // the first cascade the sweeps and the table cover
     swept: u32,                                               // how many, from it
     cell_slice: u32,                                          // the slice of the swept cells' rows a warm turn updates
-    turn_frame: u32,                                          // which frame of a warm turn this is (the passes record only its part)
+    pad0: u32,
 }
 @group(3) @binding(4) var<uniform> volume_solve: LightVolumeSolve;
 

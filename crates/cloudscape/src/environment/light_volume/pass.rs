@@ -37,11 +37,16 @@ const ENTRIES: [&str; 9] = [
 /// 6 m through cells 333 m wide).
 pub const CELL_SLICES: u32 = 8;
 
-/// Frames a warm turn is spread over, one part each: the slice of the cells' inputs, the sweeps,
-/// the table. Each frame then carries a third of the volume's work, evenly, rather than all of it
-/// (a cascade still gets ten sweeps a second at 60 fps, against clouds that cross one of its cells
-/// in 40 s); the environment reads the last table until the turn writes the next.
-pub const WARM_TURN_FRAMES: u32 = 3;
+/// The table's pass among [`LIGHT_VOLUME_PASS_NAMES`]: its frame of a warm turn also copies the
+/// table into the environment's texture.
+const TABLE_PART: usize = 2;
+
+/// Frames a warm turn is spread over, one part each, the passes of [`LIGHT_VOLUME_PASS_NAMES`]: the
+/// slice of the cells' inputs, the sweeps, the table. Each frame then carries a third of the
+/// volume's work, evenly, rather than all of it (a cascade still gets ten sweeps a second at 60
+/// fps, against clouds that cross one of its cells in 40 s); the environment reads the last table
+/// until the turn writes the next.
+pub const WARM_TURN_FRAMES: u32 = LIGHT_VOLUME_PASS_NAMES.len() as u32;
 
 /// The most cells (of any cascade) a recentred grid may have moved for its solve to start from the
 /// last solution scrolled: twice [`super::RECENTRE_CELLS`] (in the default scene 2.7 km, a frame's
@@ -126,11 +131,13 @@ impl LightVolumePass {
             "the light volume's columns hold at most {MAX_COLUMN_CELLS} cells"
         );
         let remade = self.ensure_buffers(ctx, grid);
+        let turn_frame = (self.warm_frames % WARM_TURN_FRAMES) as usize;
         let (solve, moved_cells) = self.plan(grid, !remade && may_start_warm);
+        // A cold or scrolled frame records every pass; a warm one its turn's part.
+        let records = |part: usize| moved_cells != Some(0) || part == turn_frame;
         ctx.queue
             .write_buffer(&self.solve, 0, bytemuck::bytes_of(&solve));
         let buffers = self.buffers.as_ref().expect("made above");
-        let parts = TurnParts::of(moved_cells, solve.turn_frame);
         let passes = [
             cells_steps(grid, &solve, moved_cells),
             solve_steps(grid, &solve, moved_cells, settings),
@@ -159,12 +166,7 @@ impl LightVolumePass {
         });
         let writing = environment.bind_group_writing(EnvironmentTable::LightVolume);
         let groups = shared.bind_groups_with(pass.slots, writing, group);
-        let parts_of_turn = [parts.cells, parts.sweeps, parts.table];
-        for ((label, steps), part) in LIGHT_VOLUME_PASS_NAMES
-            .iter()
-            .zip(passes)
-            .zip(parts_of_turn)
-        {
+        for (part, (label, steps)) in LIGHT_VOLUME_PASS_NAMES.iter().zip(passes).enumerate() {
             let writes = timer
                 .as_deref_mut()
                 .and_then(|t| t.compute_pass_writes(label));
@@ -172,7 +174,7 @@ impl LightVolumePass {
                 label: Some(label),
                 timestamp_writes: writes,
             });
-            if !part {
+            if !records(part) {
                 continue;
             }
             for (i, g) in groups.iter().enumerate() {
@@ -185,7 +187,7 @@ impl LightVolumePass {
                 compute.dispatch_workgroups(size.x.div_ceil(8), size.y.div_ceil(8), 1);
             }
         }
-        if parts.table {
+        if records(TABLE_PART) {
             let table = environment.texture(EnvironmentTable::LightVolume);
             copy_table(encoder, (&buffers[3], table), grid, &solve);
         }
@@ -215,7 +217,6 @@ impl LightVolumePass {
             *c = s.extend(0).extend(0);
         }
         let turn = self.warm_frames / WARM_TURN_FRAMES;
-        solve.turn_frame = self.warm_frames % WARM_TURN_FRAMES;
         (solve.first_swept, solve.swept) = match moved_cells {
             Some(0) => (turn % cascades, 1),
             _ => (0, cascades),
@@ -226,25 +227,6 @@ impl LightVolumePass {
             _ => 0,
         };
         (solve, moved_cells)
-    }
-}
-
-/// Which of the volume's passes a frame records: all of them in a cold or scrolled frame, one in
-/// each frame of a warm turn.
-struct TurnParts {
-    cells: bool,
-    sweeps: bool,
-    table: bool,
-}
-
-impl TurnParts {
-    fn of(moved_cells: Option<u32>, turn_frame: u32) -> TurnParts {
-        let warm = moved_cells == Some(0);
-        TurnParts {
-            cells: !warm || turn_frame == 0,
-            sweeps: !warm || turn_frame == 1,
-            table: !warm || turn_frame == 2,
-        }
     }
 }
 
@@ -316,8 +298,7 @@ struct SolveUniform {
     swept: u32,
     /// The slice of the swept cascades' rows whose inputs a warm turn updates.
     cell_slice: u32,
-    /// Which frame of a warm turn this is ([`WARM_TURN_FRAMES`]).
-    turn_frame: u32,
+    pad0: u32,
 }
 
 /// Texels of a row of the staged table for `width` cells: padded to [`ROW_TEXELS`].
@@ -412,7 +393,7 @@ mod tests {
                 first_swept,
                 swept,
                 cell_slice,
-                turn_frame
+                pad0
             }
         );
     }
