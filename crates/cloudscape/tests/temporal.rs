@@ -176,7 +176,7 @@ fn grid_contrast(image: &LdrImage, reference: &LdrImage, period: usize) -> f64 {
 }
 
 #[test]
-fn the_update_grid_does_not_show_while_the_camera_moves() {
+fn neither_the_update_grid_nor_blurred_edges_show_while_the_camera_moves() {
     let ctx = GpuContext::for_tests();
     let scene = scene();
     let start = Vec3::from_array(scene.camera.position_m);
@@ -200,6 +200,18 @@ fn the_update_grid_does_not_show_while_the_camera_moves() {
     let shown = grid_contrast(&last, &reference, 4);
     let natural = grid_contrast(&marched, &reference, 4);
     eprintln!("4x4 pattern in the error: temporal {shown:.5}, full march {natural:.5}");
+    let (temporal_flip, full_flip) = (
+        flip_mean(&reference, &last),
+        flip_mean(&reference, &marched),
+    );
+    eprintln!("FLIP against converged: temporal {temporal_flip:.4}, full march {full_flip:.4}");
+    // The moving clouds' edges: between rays the estimate takes the samples on the history's side
+    // of an edge (`upsample_cloud_guided`); blended across it, as wide as the grid's spacing, the
+    // temporal march scored 1.40 times the full march's FLIP here (1.26 guided).
+    assert!(
+        temporal_flip < 1.33 * full_flip,
+        "moving edges blur: temporal FLIP {temporal_flip} against the full march's {full_flip}"
+    );
     assert!(
         shown < 1.5 * natural,
         "the 4x4 update grid shows: {shown} against {natural} in the full march's error"

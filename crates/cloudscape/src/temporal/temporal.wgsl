@@ -174,7 +174,8 @@ fn resolve_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     if temporal.history_valid == 1u && on_screen && temporal_same_cloud(uv, pixel, lo_m, hi_m) {
         let gamma = temporal.clip_gamma;
         let reprojected = temporal_history_bicubic(uv);
-        let guide = UpsampleGuide(reprojected, gamma * sigma + 1.0e-4, 1.0);
+        let guided = select(0.0, 1.0, divisor >= TEMPORAL_GUIDED_DIVISOR);
+        let guide = UpsampleGuide(reprojected, gamma * sigma + 1.0e-4, guided);
         let current = upsample_cloud_guided(id.xy, host_m, guide).radiance_transmittance;
         // The box is centred on this pixel's own estimate, which varies smoothly from pixel to
         // pixel, rather than on the block's mean, which would print the grid's blocks into it.
