@@ -174,6 +174,9 @@ fn resolve_clouds(@builtin(global_invocation_id) id: vec3<u32>) {
     if temporal.history_valid == 1u && on_screen && temporal_same_cloud(uv, pixel, lo_m, hi_m) {
         let gamma = temporal.clip_gamma;
         let reprojected = temporal_history_bicubic(uv);
+        // The plain estimate gave the distance to reproject at; on the coarsest grid its radiance
+        // is taken again with the history as the guide (select, not a branch on the uniform:
+        // lavapipe recompiles shaders that branch on a uniform alone).
         let guided = select(0.0, 1.0, divisor >= TEMPORAL_GUIDED_DIVISOR);
         let guide = UpsampleGuide(reprojected, gamma * sigma + 1.0e-4, guided);
         let current = upsample_cloud_guided(id.xy, host_m, guide).radiance_transmittance;

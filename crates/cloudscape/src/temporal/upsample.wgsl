@@ -26,6 +26,7 @@ fn upsample_grid_texel(texel: vec2<i32>) -> vec2<i32> {
     return clamp(texel, vec2<i32>(0), vec2<i32>(textureDimensions(coarse_clouds)) - 1);
 }
 
+// The part of its bilinear share a sample keeps however unlike the guide it is.
 const UPSAMPLE_GUIDE_FLOOR: f32 = 0.05;
 
 // The estimate at full-resolution pixel `px` from the coarse output:
@@ -61,7 +62,8 @@ fn upsample_cloud_guided(px: vec2<u32>, host_m: f32, guide: UpsampleGuide) -> Up
         let depth_m = textureLoad(coarse_distance, texel, 0).x;
         let sample = textureLoad(coarse_clouds, texel, 0);
         let unlike = (sample - guide.value) / guide.scale;
-        let w = w2.x * w2.y * select(1.0, 0.0, depth_m > host_m) * mix(1.0, UPSAMPLE_GUIDE_FLOOR + exp(-0.5 * dot(unlike, unlike)), guide.strength) + 1.0e-6;
+        let likeness = mix(1.0, UPSAMPLE_GUIDE_FLOOR + exp(-0.5 * dot(unlike, unlike)), guide.strength);
+        let w = w2.x * w2.y * select(1.0, 0.0, depth_m > host_m) * likeness + 1.0e-6;
         value += sample * w;
         weight += w;
         cloud_m += depth_m * w * (1.0 - sample.a);
