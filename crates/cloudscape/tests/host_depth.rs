@@ -6,6 +6,7 @@ use cloudscape::frame::{DepthConvention, Frame};
 use cloudscape::gpu::{GpuContext, read_texture_rgba16f};
 use cloudscape::renderer::{CloudRenderer, Reuse};
 use cloudscape::scene::{Scene, Technique};
+use cloudscape::shadow::LightingReuse;
 use glam::UVec2;
 
 /// The default scene (drawn by `technique`), looking up into an overcast layer.
@@ -93,6 +94,8 @@ fn clouds_over_depth(
 fn geometry_hides_the_clouds(technique: Technique, max_clear_transmittance: f32) {
     let ctx = GpuContext::for_tests();
     let mut clouds = renderer(&ctx, technique);
+    // The lighting carried from frame to frame: these frames differ in their depth alone.
+    clouds.set_lighting_reuse(Some(LightingReuse::REAL_TIME));
     for convention in DepthConvention::ALL {
         let draw = |clouds: &mut CloudRenderer, wall_m| {
             clouds_over_depth(&ctx, clouds, convention, wall_m, (technique, Reuse::None))

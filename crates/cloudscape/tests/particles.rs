@@ -97,6 +97,10 @@ fn small_grid_scene(overrides: &[&str]) -> Scene {
         "particles.resolution_divisor=1",
         "particles.table_resolution=low",
         "render.technique=particles",
+        // A small light volume: these tests follow the particles' making, occlusion and blending,
+        // and the default volume's cold solve would be most of each frame on a software GPU.
+        "lighting.volume_cells_horizontal=16",
+        "lighting.volume_cells_vertical=8",
     ];
     all.extend_from_slice(overrides);
     let all: Vec<String> = all.iter().map(|s| s.to_string()).collect();

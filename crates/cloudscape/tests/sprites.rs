@@ -6,6 +6,7 @@ use cloudscape::gpu::{GpuContext, PassTimer};
 use cloudscape::image::{HdrImage, LdrImage, flip};
 use cloudscape::renderer::{PASS_COUNT, Reuse, SceneRenderer};
 use cloudscape::scene::{Scene, SceneDocument};
+use cloudscape::shadow::LightingReuse;
 use glam::UVec2;
 use std::path::Path;
 
@@ -69,6 +70,8 @@ fn fly_through(ctx: &GpuContext, frames: u32) -> Vec<HdrImage> {
         boxes = [{ center_m = [0.0, 0.0, 0.0], size_m = [1800.0, 900.0, 1800.0] }]\n";
     let base = scene(toml, &[], size);
     let mut renderer = SceneRenderer::new(ctx, &base, Path::new(".")).expect("builds");
+    // The lighting carried across frames, as a game flying through it carries it.
+    (renderer.clouds()).set_lighting_reuse(Some(LightingReuse::REAL_TIME));
     let mut timer = PassTimer::new(ctx, PASS_COUNT);
     (0..frames)
         .map(|i| {

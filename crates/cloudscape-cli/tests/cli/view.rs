@@ -12,12 +12,12 @@ use crate::support::{Run, Scratch, command, run};
 use crate::xvfb::Xvfb;
 use cloudscape::image::{HdrImage, LdrImage, flip};
 
-/// Frames of every run: enough for the temporal history (a 2x2 grid) to fill in.
+/// Frames of a run with temporal reuse: enough for the history (a 2x2 grid) to fill in.
 const FRAMES: &str = "24";
 
-/// `cloudscape view` with the test window and `args`, in `dir`, on its own X server; None when the
-/// machine has no X server to give it (see [`Xvfb::start`]).
-fn view(dir: &Path, args: &[&str]) -> Option<Run> {
+/// `cloudscape view` with the test window and `args` for `frames` frames, in `dir`, on its own X
+/// server; None when the machine has no X server to give it (see [`Xvfb::start`]).
+fn view(dir: &Path, frames: &str, args: &[&str]) -> Option<Run> {
     let xvfb = Xvfb::start()?;
     let mut all = vec![
         "view",
@@ -31,7 +31,7 @@ fn view(dir: &Path, args: &[&str]) -> Option<Run> {
         "--set",
         "render.quality=low",
         "--frames",
-        FRAMES,
+        frames,
     ];
     all.extend(args);
     let mut command = command(dir, &all, true);
@@ -52,7 +52,7 @@ fn write(scratch: &Scratch, name: &str, text: &str) {
 fn view_renders_its_frames_in_a_window_and_matches_its_golden() {
     let scratch = Scratch::new("view-golden");
     let args = ["--temporal", "2", "--screenshot", "shot.png"];
-    let Some(run) = view(scratch.path(), &args) else {
+    let Some(run) = view(scratch.path(), FRAMES, &args) else {
         return;
     };
     assert!(run.stderr.contains("adapter: "), "{}", run.stderr);
@@ -77,7 +77,7 @@ fn a_scripted_coverage_change_changes_the_image() {
         "--screenshot",
         "shot.png",
     ];
-    if view(scratch.path(), &args).is_none() {
+    if view(scratch.path(), FRAMES, &args).is_none() {
         return;
     }
     let changed = LdrImage::read_png(&scratch.join("shot.png")).expect("the screenshot");
@@ -102,7 +102,8 @@ fn a_saved_scene_renders_exactly_as_it_was_viewed() {
                   [[at]]\nframe = 9\nscreenshot = \"viewed.png\"\nsave = \"saved.toml\"\n";
     write(&scratch, "script.toml", script);
     let args = ["--script", "script.toml", "--temporal", "off"];
-    if view(scratch.path(), &args).is_none() {
+    // Its script ends at frame 9; without temporal reuse each frame solves the lighting anew.
+    if view(scratch.path(), "10", &args).is_none() {
         return;
     }
     let render = run(command(
@@ -128,7 +129,7 @@ fn the_render_follows_the_window_when_it_is_resized() {
         "[[at]]\nframe = 3\nwindow_size = [240, 100]\n",
     );
     let args = ["--script", "script.toml", "--screenshot", "shot.png"];
-    if view(scratch.path(), &args).is_none() {
+    if view(scratch.path(), FRAMES, &args).is_none() {
         return;
     }
     let shot = LdrImage::read_png(&scratch.join("shot.png")).expect("the screenshot");
