@@ -71,7 +71,9 @@ fn fly_through(ctx: &GpuContext, frames: u32) -> Vec<HdrImage> {
     let base = scene(toml, &[], size);
     let mut renderer = SceneRenderer::new(ctx, &base, Path::new(".")).expect("builds");
     // The lighting carried across frames, as a game flying through it carries it.
-    (renderer.clouds()).set_lighting_reuse(Some(LightingReuse::REAL_TIME));
+    renderer
+        .clouds()
+        .set_lighting_reuse(Some(LightingReuse::REAL_TIME));
     let mut timer = PassTimer::new(ctx, PASS_COUNT);
     (0..frames)
         .map(|i| {

@@ -50,7 +50,9 @@ impl Sequence {
     /// light volume solved cold every frame would be most of a frame's cost on a software GPU.
     fn new(ctx: &GpuContext, scene: &Scene, divisor: u32) -> Sequence {
         let mut renderer = SceneRenderer::new(ctx, scene, Path::new(".")).expect("field");
-        (renderer.clouds()).set_lighting_reuse(Some(LightingReuse::REAL_TIME));
+        renderer
+            .clouds()
+            .set_lighting_reuse(Some(LightingReuse::REAL_TIME));
         Sequence {
             renderer,
             timer: PassTimer::new(ctx, PASS_COUNT),
