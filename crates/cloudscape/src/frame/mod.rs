@@ -198,6 +198,15 @@ impl Frame {
         }
     }
 
+    /// Sample `index` of `samples` over each pixel's footprint: this frame shifted so that every
+    /// pixel is seen through [`Frame::footprint_point`] of itself, its frame index the sample's.
+    pub fn footprint_sample(&self, index: u32, samples: u32) -> Frame {
+        Frame {
+            frame_index: index,
+            ..self.shifted_by(Frame::footprint_point(index, samples) - 0.5)
+        }
+    }
+
     /// The same frame seen through a depth buffer of convention `depth`: the projection is rebuilt
     /// for it from the scene camera's field of view and planes.
     pub fn with_depth(self, scene: &Scene, depth: DepthConvention) -> Frame {

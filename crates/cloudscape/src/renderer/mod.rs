@@ -156,7 +156,8 @@ impl SceneRenderer {
     /// rasterising techniques (particles, sprites) draw the whole frame once per sample, each
     /// through its own point of the pixel ([`Frame::footprint_point`], a sub-pixel shift of the
     /// projection), and the HDR frames are averaged: the pixel's footprint, as the path tracer
-    /// integrates it.
+    /// integrates it. The samples share one lighting: the first frame makes the environment (shadow
+    /// map, sky tables, light volume) and the others draw over it ([`CloudRenderer::begin_shifted_frame`]).
     pub fn render(&mut self, ctx: &GpuContext, mut progress: impl FnMut(f32)) -> Rendered {
         let render = &self.scene.render;
         let frame = Frame::from_scene(&self.scene, UVec2::new(render.width, render.height));
@@ -165,18 +166,15 @@ impl SceneRenderer {
             Technique::Particles | Technique::Sprites => render.samples_per_pixel.unwrap_or(1),
         };
         if samples <= 1 {
-            return self.render_in_bands(ctx, &frame, &mut progress);
+            return self.render_in_bands(ctx, (&frame, false), &mut progress);
         }
         let (exposure_ev, tonemap) = (render.exposure_ev, render.tonemap);
         let mut sum = HdrImage::new(frame.size.x, frame.size.y);
         for index in 0..samples {
-            let shifted = Frame {
-                frame_index: index,
-                ..frame.shifted_by(Frame::footprint_point(index, samples) - 0.5)
-            };
+            let shifted = frame.footprint_sample(index, samples);
             let done = index as f32;
             let hdr = self
-                .render_in_bands(ctx, &shifted, &mut |f| {
+                .render_in_bands(ctx, (&shifted, index > 0), &mut |f| {
                     progress((done + f) / samples as f32)
                 })
                 .hdr;
@@ -191,16 +189,21 @@ impl SceneRenderer {
     }
 
     /// Renders `frame` in bands of [`TILE_ROWS`] output rows, one submission each, calling
-    /// `progress` with the fraction done after each.
+    /// `progress` with the fraction done after each; `shifted`: over the environment of the frame
+    /// before ([`CloudRenderer::begin_shifted_frame`]).
     fn render_in_bands(
         &mut self,
         ctx: &GpuContext,
-        frame: &Frame,
+        (frame, shifted): (&Frame, bool),
         progress: &mut dyn FnMut(f32),
     ) -> Rendered {
         self.host(ctx, frame);
         let host = self.host.as_ref().expect("made above");
-        self.clouds.begin_frame(ctx, frame, Reuse::None);
+        if shifted {
+            self.clouds.begin_shifted_frame(ctx, frame);
+        } else {
+            self.clouds.begin_frame(ctx, frame, Reuse::None);
+        }
         let output = self.clouds.output_size();
         for row in (0..output.y).step_by(TILE_ROWS as usize) {
             let band = (
