@@ -82,6 +82,21 @@ impl Drop for PendingFile {
     }
 }
 
+/// The user's cache directory, where derived files that take long to make are kept (the
+/// particles' tables, the field's noise): `$CLOUDSCAPE_CACHE_DIR`, else `$XDG_CACHE_HOME/cloudscape`, else
+/// `~/.cache/cloudscape`, else `cloudscape-cache` in the system's temporary directory.
+pub fn cache_dir() -> PathBuf {
+    let var = |name: &str| {
+        std::env::var_os(name)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    var("CLOUDSCAPE_CACHE_DIR")
+        .or_else(|| var("XDG_CACHE_HOME").map(|d| d.join("cloudscape")))
+        .or_else(|| var("HOME").map(|d| d.join(".cache").join("cloudscape")))
+        .unwrap_or_else(|| std::env::temp_dir().join("cloudscape-cache"))
+}
+
 /// Runs `write` on a temporary file beside `path`, then flushes, syncs and renames it over
 /// `path`, so that readers never see a partial file. On any error the temporary file is removed
 /// and `path` is left as it was.
@@ -148,6 +163,11 @@ impl ScratchDir {
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).expect("create scratch dir");
         ScratchDir(dir)
+    }
+
+    /// The directory.
+    pub(crate) fn path(&self) -> &Path {
+        &self.0
     }
 
     /// The path of `name` inside the directory.

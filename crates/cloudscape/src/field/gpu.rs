@@ -4,14 +4,16 @@
 
 use super::brick::{BRICK_TEXELS, BRICK_VOXELS};
 use super::hiheight::HiHeight;
+use super::noise_cache::{self, NoiseOrigin};
 use super::placed::FileGrid;
 use super::{CloudField, MAX_LAYERS, MAX_VOLUMES, NoiseKind};
-use crate::gpu::GpuContext;
 use crate::gpu::pipeline::{
     UNIFORM, bind_group, bind_group_layout, float_texture, storage_binding, storage_buffer,
 };
+use crate::gpu::{GpuContext, readback};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
+use std::path::Path;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
@@ -410,7 +412,9 @@ fn create_texture(
         sample_count: 1,
         dimension,
         format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_DST
+            | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     })
 }
@@ -495,18 +499,62 @@ struct NoiseGenParams {
     depth: u32,
 }
 
-/// The noise texture of `kind` for `seed`, made once per device ([`GpuContext::shared_texture`]).
+/// The noise texture of `kind` for `seed`, made once per device ([`GpuContext::shared_texture`])
+/// and kept on disk between runs ([`super::noise_cache`]).
 fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture {
     let key = (kind.texture_name(), u64::from(seed));
-    ctx.shared_texture(key, || make_noise(ctx, kind, seed))
+    let dir = crate::fsutil::cache_dir();
+    ctx.shared_texture(key, || cached_noise(ctx, kind, seed, &dir))
+}
+
+/// The noise texture of `kind` for `seed` from its file in `dir`, or made on the GPU and its
+/// texels written there.
+fn cached_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32, dir: &Path) -> wgpu::Texture {
+    let dims = kind.dims();
+    let row_texels = noise_row_texels(dims);
+    let program = crate::shader::Program::new(&NOISE_GEN_WGSL);
+    let adapter = format!("{:?}", ctx.adapter_info());
+    let origin = NoiseOrigin {
+        name: kind.texture_name(),
+        seed,
+        program: program.text(),
+        layout: [row_texels, dims.y, dims.z],
+        adapter: &adapter,
+    };
+    let path = origin.path(dir);
+    let len = (4 * row_texels * dims.y * dims.z) as usize;
+    if let Some(texels) = noise_cache::read(&path, len) {
+        let texture = noise_texture(ctx, kind);
+        write_texture(ctx, &texture, &texels, 4 * row_texels, dims);
+        return texture;
+    }
+    let (texture, texels) = make_noise(ctx, kind, seed);
+    noise_cache::write(&path, &readback::read_buffer::<u8>(ctx, &texels));
+    texture
+}
+
+/// Texels per row of the generator's buffer: rows padded to what a buffer-to-texture copy needs.
+fn noise_row_texels(dims: glam::UVec3) -> u32 {
+    (dims.x * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) / 4
+}
+
+/// An empty noise texture of `kind`: 3D, or 2D for the curl noise.
+fn noise_texture(ctx: &GpuContext, kind: NoiseKind) -> wgpu::Texture {
+    let dimension = if kind == NoiseKind::Curl {
+        wgpu::TextureDimension::D2
+    } else {
+        wgpu::TextureDimension::D3
+    };
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    create_texture(ctx, kind.texture_name(), kind.dims(), format, dimension)
 }
 
 /// Runs `noise_gen.wgsl` into a storage buffer and copies it into a texture (a path that works on
-/// every backend, GL included, unlike 3D storage-texture writes).
-fn make_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture {
+/// every backend, GL included, unlike 3D storage-texture writes); the texture and the buffer.
+fn make_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> (wgpu::Texture, wgpu::Buffer) {
     let device = &ctx.device;
     let dims = kind.dims();
-    let row_pitch = (dims.x * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) / 4;
+    let row_pitch = noise_row_texels(dims);
     let params = NoiseGenParams {
         kind: kind.gpu_index(),
         seed,
@@ -537,18 +585,7 @@ fn make_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture {
             ("noise_texels", buffer.as_entire_binding()),
         ],
     );
-    let dimension = if kind == NoiseKind::Curl {
-        wgpu::TextureDimension::D2
-    } else {
-        wgpu::TextureDimension::D3
-    };
-    let texture = create_texture(
-        ctx,
-        kind.texture_name(),
-        dims,
-        wgpu::TextureFormat::Rgba8Unorm,
-        dimension,
-    );
+    let texture = noise_texture(ctx, kind);
     let mut encoder = device.create_command_encoder(&Default::default());
     {
         let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -573,7 +610,7 @@ fn make_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture {
         },
     );
     ctx.queue.submit([encoder.finish()]);
-    texture
+    (texture, buffer)
 }
 
 /// The cloud field on the GPU (`field.wgsl`, group [`crate::shader::FIELD_GROUP`]): the twin of [`super::CloudField`].
@@ -618,6 +655,31 @@ impl crate::pass::SharedGroup for FieldGpu {
 mod tests {
     use super::*;
     use crate::gpu::layout_check::assert_wgsl_layout;
+
+    /// The first field on a machine makes its noise and writes it to the cache; the next reads the
+    /// file (here one written over with other texels, to tell a read from a remake), and a damaged
+    /// file is made again.
+    #[test]
+    fn noise_is_made_once_then_read_from_its_cache_file() {
+        let ctx = GpuContext::for_tests();
+        let dir = crate::fsutil::ScratchDir::new("noise-cache");
+        let (kind, seed) = (NoiseKind::Detail, 11);
+        let texels = |ctx: &GpuContext| {
+            readback::read_texture(ctx, &cached_noise(ctx, kind, seed, dir.path()))
+        };
+        let made = texels(&ctx);
+        let files = dir.entries();
+        assert_eq!(files.len(), 1, "one file: {files:?}");
+        let path = dir.join(&files[0]);
+        let len = std::fs::metadata(&path).expect("written").len() as usize - 8;
+        noise_cache::write(&path, &vec![0x80; len]);
+        assert!(texels(&ctx).iter().all(|&t| t == 0x80), "the file is read");
+        let mut damaged = std::fs::read(&path).expect("written");
+        damaged[3] ^= 1;
+        std::fs::write(&path, damaged).expect("rewritten");
+        assert!(texels(&ctx) == made, "a damaged file is made again");
+        assert_eq!(dir.entries(), files);
+    }
 
     #[test]
     fn field_uniforms_match_their_wgsl_layouts() {

@@ -10,6 +10,7 @@ pub mod gpu;
 pub mod hiheight;
 mod layer;
 pub mod noise;
+mod noise_cache;
 mod placed;
 pub mod profile;
 pub mod read_gpu;

@@ -44,9 +44,9 @@ impl TableStore {
         TableStore { dir: dir.into() }
     }
 
-    /// The store in the user's cache directory ([`super::table_file::cache_dir`]).
+    /// The store in the user's cache directory ([`crate::fsutil::cache_dir`]).
     pub fn user_cache() -> TableStore {
-        TableStore::new(super::table_file::cache_dir())
+        TableStore::new(crate::fsutil::cache_dir())
     }
 
     /// The path of the scattering tables with `key`.

@@ -317,20 +317,6 @@ impl KeyHasher {
     }
 }
 
-/// Where table files are cached: `$CLOUDSCAPE_CACHE_DIR`, else `$XDG_CACHE_HOME/cloudscape`, else
-/// `~/.cache/cloudscape`, else `cloudscape-cache` in the system's temporary directory.
-pub fn cache_dir() -> PathBuf {
-    let var = |name: &str| {
-        std::env::var_os(name)
-            .filter(|v| !v.is_empty())
-            .map(PathBuf::from)
-    };
-    var("CLOUDSCAPE_CACHE_DIR")
-        .or_else(|| var("XDG_CACHE_HOME").map(|d| d.join("cloudscape")))
-        .or_else(|| var("HOME").map(|d| d.join(".cache").join("cloudscape")))
-        .unwrap_or_else(|| std::env::temp_dir().join("cloudscape-cache"))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
