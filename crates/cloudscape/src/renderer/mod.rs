@@ -157,7 +157,8 @@ impl SceneRenderer {
     /// through its own point of the pixel ([`Frame::footprint_point`], a sub-pixel shift of the
     /// projection), and the HDR frames are averaged: the pixel's footprint, as the path tracer
     /// integrates it. The samples share one lighting: the first frame makes the environment (shadow
-    /// map, sky tables, light volume) and the others draw over it ([`CloudRenderer::begin_shifted_frame`]).
+    /// map, sky tables, light volume), and the others redo only the aerial perspective laid over
+    /// their view ([`CloudRenderer::begin_shifted_frame`]).
     pub fn render(&mut self, ctx: &GpuContext, mut progress: impl FnMut(f32)) -> Rendered {
         let render = &self.scene.render;
         let frame = Frame::from_scene(&self.scene, UVec2::new(render.width, render.height));
