@@ -125,12 +125,7 @@ fn shifted_samples_share_the_lighting_and_follow_the_view() {
         // A whole frame begun afresh: without lighting reuse it makes its own lighting.
         let sample = frame.footprint_sample(index, samples);
         renderer.render_frame(&ctx, &sample, Reuse::None, &mut timer);
-        let hdr = renderer.images(&ctx).hdr;
-        for (total, pixel) in mean.pixels.iter_mut().zip(&hdr.pixels) {
-            for (t, p) in total.iter_mut().zip(pixel) {
-                *t += p / samples as f32;
-            }
-        }
+        mean.add_scaled(&renderer.images(&ctx).hdr, 1.0 / samples as f32);
     }
     let ldr =
         |image: &HdrImage| image.to_ldr(doc.scene.render.exposure_ev, doc.scene.render.tonemap);

@@ -503,8 +503,9 @@ struct NoiseGenParams {
 /// and kept on disk between runs ([`super::noise_cache`]).
 fn generate_noise(ctx: &GpuContext, kind: NoiseKind, seed: u32) -> wgpu::Texture {
     let key = (kind.texture_name(), u64::from(seed));
-    let dir = crate::fsutil::cache_dir();
-    ctx.shared_texture(key, || cached_noise(ctx, kind, seed, &dir))
+    ctx.shared_texture(key, || {
+        cached_noise(ctx, kind, seed, &crate::fsutil::cache_dir())
+    })
 }
 
 /// The noise texture of `kind` for `seed` from its file in `dir`, or made on the GPU and its

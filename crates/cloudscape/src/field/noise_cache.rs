@@ -32,9 +32,9 @@ impl NoiseOrigin<'_> {
     pub fn path(&self, dir: &Path) -> PathBuf {
         let mut hash = StableHasher::new();
         hash.str(self.program);
-        self.layout.iter().for_each(|n| {
-            hash.u32(*n);
-        });
+        for n in self.layout {
+            hash.u32(n);
+        }
         hash.str(self.adapter);
         let name = self.name.replace(' ', "-");
         dir.join(format!("{name}-{}-{:016x}.bin", self.seed, hash.finish()))

@@ -151,6 +151,17 @@ impl HdrImage {
         self
     }
 
+    /// Adds `weight` times `other` (the same size) to this image, pixel by pixel and channel by
+    /// channel: a running mean of frames, each weighted by one over their count.
+    pub fn add_scaled(&mut self, other: &HdrImage, weight: f32) {
+        debug_assert_eq!(self.pixels.len(), other.pixels.len());
+        for (total, pixel) in self.pixels.iter_mut().zip(&other.pixels) {
+            for (t, p) in total.iter_mut().zip(pixel) {
+                *t += p * weight;
+            }
+        }
+    }
+
     /// The display image: exposure by `exposure_ev` stops, tone mapping by `op`, sRGB encoding;
     /// alpha is quantised linearly.
     pub fn to_ldr(&self, exposure_ev: f32, op: Tonemap) -> LdrImage {
@@ -217,6 +228,26 @@ impl LdrImage {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn adding_scaled_frames_makes_their_mean() {
+        let a = hdr_sample();
+        let mut mean = HdrImage::new(a.width, a.height);
+        let doubled = HdrImage {
+            pixels: a.pixels.iter().map(|p| p.map(|v| 2.0 * v)).collect(),
+            ..a.clone()
+        };
+        mean.add_scaled(&a, 0.5);
+        mean.add_scaled(&doubled, 0.5);
+        for (m, p) in mean.pixels.iter().zip(&a.pixels) {
+            for (mc, pc) in m.iter().zip(p) {
+                assert!(
+                    (mc - 1.5 * pc).abs() <= 1e-6 * pc.abs(),
+                    "{mc} against {pc}"
+                );
+            }
+        }
+    }
 
     /// A 4x3 HDR image over several decades, with varying alpha (the file tests' sample).
     pub(super) fn hdr_sample() -> HdrImage {

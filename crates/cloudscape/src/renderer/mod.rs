@@ -179,11 +179,7 @@ impl SceneRenderer {
                     progress((done + f) / samples as f32)
                 })
                 .hdr;
-            for (total, pixel) in sum.pixels.iter_mut().zip(&hdr.pixels) {
-                for (t, p) in total.iter_mut().zip(pixel) {
-                    *t += p / samples as f32;
-                }
-            }
+            sum.add_scaled(&hdr, 1.0 / samples as f32);
         }
         let ldr = sum.to_ldr(exposure_ev, tonemap);
         Rendered { hdr: sum, ldr }
